@@ -1,0 +1,123 @@
+"""What the AI sees of the world, and the controller interfaces the world drives.
+
+The world (``game``) builds a :class:`WorldView` whenever a decision or an AI tick is due
+and hands it to a :class:`GuardAI` (one object for the whole guard team, since the fields
+are shared) or a :class:`PlayerPolicy`. Controllers answer with node indices of the
+level's :class:`~navmesh.graph.NodeGraph`; the world turns them into movement. The AI
+never touches pymunk and never learns which abstraction it runs on.
+"""
+
+from __future__ import annotations
+
+from abc import ABC, abstractmethod
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from navmesh.graph import NodeGraph
+
+
+@dataclass(frozen=True)
+class Event:
+    """Something that happened in the world this AI tick that a mechanic may react to.
+
+    ``kind`` examples: ``"sprint"``, ``"throw_landed"``, ``"decoy_activated"``,
+    ``"guard_down"``, ``"guard_on"`` (a guard standing on a decoy or corpse),
+    ``"weather"``. ``node`` is where it happened; ``data`` carries anything else.
+    """
+
+    kind: str
+    node: int = -1
+    t: float = 0.0
+    data: Mapping[str, Any] = field(default_factory=dict)
+
+
+@dataclass
+class WorldView:
+    """A read-only snapshot of the world for the controllers (world units, y down)."""
+
+    t: float
+    graph: NodeGraph
+    guard_nodes: np.ndarray
+    guard_positions: np.ndarray
+    guard_headings: np.ndarray
+    player_node: int
+    player_pos: np.ndarray
+    #: indices of the guards that see the player right now
+    seen_by: tuple[int, ...] = ()
+    #: node where the player was last seen since the previous AI tick, else None
+    sighting: int | None = None
+    events: tuple[Event, ...] = ()
+    #: per-node boolean masks of zones, e.g. ``{"dark": mask, "concealment": mask}``
+    zones: Mapping[str, np.ndarray] = field(default_factory=dict)
+    #: guards still in play (a guard taken down is inactive)
+    guard_active: np.ndarray | None = None
+
+    @property
+    def n_guards(self) -> int:
+        return len(self.guard_nodes)
+
+
+def move_horizon(graph: NodeGraph, factor: float = 2.5) -> float:
+    """How far one decision may reach: one cell on the grid, ``factor`` mean edges on a mesh.
+
+    Baseline controllers with a far goal step along their shortest path by this much, so
+    on the grid they move one neighbouring cell per decision (SPEC §6) and on the
+    partition they hop a corridor stretch the world walks by funnel path.
+    """
+    if graph.kind == "grid":
+        return graph.cell_size * 1.01
+    return factor * graph.mean_edge_length
+
+
+class GuardAI(ABC):
+    """The brain of the whole guard team.
+
+    ``reset`` is called once per trial, ``tick`` once per AI tick (default 1 s) to advance
+    shared state (fields, weights, timers), ``decide`` whenever guard ``i`` reaches its
+    current target node and needs the next one.
+    """
+
+    #: short mode name used on the command line (``pf``, ``random``, ...)
+    mode: str = ""
+
+    def __init__(self, params: Mapping[str, Any] | None = None) -> None:
+        self.params = dict(params or {})
+
+    @abstractmethod
+    def reset(self, graph: NodeGraph, rng: np.random.Generator, n_guards: int) -> None:
+        """Start a new trial on ``graph`` with ``n_guards`` guards."""
+
+    def tick(self, view: WorldView, dt: float) -> None:
+        """Advance shared state by one AI tick of ``dt`` seconds (no-op by default)."""
+
+    @abstractmethod
+    def decide(self, i: int, view: WorldView) -> int:
+        """The next target node of guard ``i``."""
+
+    def explain(self, i: int) -> dict[str, Any] | None:
+        """Why guard ``i`` took its last decision, for modes that can say (else None)."""
+        return None
+
+    def state_name(self, i: int) -> str:
+        """A short label of guard ``i``'s behaviour state, for traces and the game HUD."""
+        return self.mode
+
+
+class PlayerPolicy(ABC):
+    """A scripted player: picks the next node whenever the player reaches its target."""
+
+    policy: str = ""
+
+    def __init__(self, params: Mapping[str, Any] | None = None) -> None:
+        self.params = dict(params or {})
+
+    @abstractmethod
+    def reset(self, graph: NodeGraph, rng: np.random.Generator) -> None:
+        """Start a new trial on ``graph``."""
+
+    @abstractmethod
+    def decide(self, view: WorldView) -> int:
+        """The player's next target node."""

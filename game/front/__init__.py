@@ -1,0 +1,1 @@
+"""The interactive pygame-ce front end: the only package that imports pygame."""

@@ -1,0 +1,557 @@
+"""The simulated world: pymunk bodies, vision cones, attack ranges, scenarios and metrics.
+
+One :class:`World` is one trial in progress. It owns the physics space, the agents and the
+metric counters, asks the controllers (``ai``) for target nodes, walks agents there (the
+neighbouring cell centre on the grid, the funnel path on the partition) and never imports
+pygame: the front end and the headless runner both drive it through :meth:`World.step`.
+"""
+
+from __future__ import annotations
+
+import math
+from collections import deque
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+import pymunk
+import shapely
+
+from ai import GuardAI, PlayerPolicy, WorldView
+from ai.view import Event
+from navmesh.graph import NodeGraph, graph_for
+from navmesh.level import Level
+
+from .config import Config
+
+WALL_CATEGORY = 0b01
+AGENT_CATEGORY = 0b10
+#: Agents collide with walls only: guards blocking each other in one-cell corridors would
+#: deadlock, and the paper's agents pass through each other too.
+AGENT_FILTER = pymunk.ShapeFilter(categories=AGENT_CATEGORY, mask=WALL_CATEGORY)
+WALL_QUERY = pymunk.ShapeFilter(mask=WALL_CATEGORY)
+
+SCENARIOS = ("capture", "fixed")
+ARRIVE_EPS = 1e-3
+#: Ranges are compared with this slack so a distance of exactly the range counts as inside
+#: whatever the last bit of the float sum of positions.
+RANGE_EPS = 1e-9
+
+
+@dataclass
+class Agent:
+    """A circle body walking towards a target node along a list of waypoints."""
+
+    body: pymunk.Body
+    speed: float
+    node: int
+    target: int
+    heading: float = 0.0
+    waypoints: deque[tuple[float, float]] = field(default_factory=deque)
+    since_target: float = 0.0
+    active: bool = True
+    history: deque[int] = field(default_factory=lambda: deque(maxlen=5))
+    #: position cached once per physics step (reading pymunk's Vec2d costs ~1 µs a time)
+    pos: tuple[float, float] = (0.0, 0.0)
+    velocity: tuple[float, float] = (0.0, 0.0)
+
+    def sync(self) -> None:
+        """Read the body's position after a physics step."""
+        p = self.body.position
+        self.pos = (p.x, p.y)
+
+    def place(self, xy: tuple[float, float]) -> None:
+        """Teleport the body (spawn, respawn) and stop it."""
+        self.body.position = xy
+        self.set_velocity((0.0, 0.0))
+        self.pos = (float(xy[0]), float(xy[1]))
+
+    def set_velocity(self, v: tuple[float, float]) -> None:
+        """Set the body's velocity, skipping the (slow) write when it is unchanged."""
+        if v != self.velocity:
+            self.body.velocity = v
+            self.velocity = v
+
+    @property
+    def needs_decision(self) -> bool:
+        return not self.waypoints
+
+
+@dataclass
+class Metrics:
+    """Counters of one trial (SPEC §7); :meth:`World.metrics` turns them into the JSON row."""
+
+    captures: int = 0
+    capture_time: float | None = None
+    first_detect_time: float | None = None
+    backtracks: int = 0
+    dist_sum: float = 0.0
+    dist_samples: int = 0
+    covered: np.ndarray | None = None
+    visits: np.ndarray | None = None
+    attacks: np.ndarray | None = None
+
+
+class World:
+    """One trial of one level, abstraction, guard team, player policy, scenario and seed.
+
+    >>> # doctest: +SKIP
+    >>> world = World(load_level("maze"), "grid", make_guard_ai("cheat"),
+    ...               make_player_policy("evade"), config=Config.defaults(), seed=1)
+    >>> while not world.done: world.step()
+    """
+
+    def __init__(
+        self,
+        level: Level,
+        abstraction: str,
+        guard_ai: GuardAI,
+        player_policy: PlayerPolicy | None,
+        *,
+        config: Config,
+        scenario: str = "capture",
+        seed: int = 0,
+        rngs: tuple[np.random.Generator, np.random.Generator, np.random.Generator] | None = None,
+        interactive: bool = False,
+        graph: NodeGraph | None = None,
+    ) -> None:
+        if scenario not in SCENARIOS:
+            raise ValueError(f"unknown scenario {scenario!r} (choose capture or fixed)")
+        self.level, self.abstraction, self.scenario = level, abstraction, scenario
+        self.config = config
+        self.graph = graph if graph is not None else graph_for(level, abstraction)
+        self.guard_ai, self.player_policy = guard_ai, player_policy
+        spawn_rng, guard_rng, player_rng = rngs or default_rngs(seed)
+        self.spawn_rng = spawn_rng
+
+        w = config.section("world")
+        s = config.section(f"scenario.{scenario}")
+        self.dt = float(w["physics_step_interactive"] if interactive else w["physics_step"])
+        self.steps_per_tick = max(1, round(float(w["ai_tick"]) / self.dt))
+        self.total_steps = round(float(w["duration"]) / self.dt)
+        self.end_on_capture = bool(s["end_on_capture"])
+        self.view_range = float(w["view_range"]) * float(s["view_range_scale"])
+        self.cos_half_fov = math.cos(math.radians(float(w["fov_deg"])) / 2)
+        self.attack_range = float(w["attack_range"])
+        self.attack_los = bool(w["attack_needs_line_of_sight"])
+        self.radius = float(w["agent_radius"])
+        self.hp_max = float(w["player_hp"])
+        self.stuck_timeout = float(w["stuck_timeout"])
+        self.sprint_factor = float(w["sprint_factor"])
+        self.concealment_view_scale = float(config["zones.concealment_view_scale"])
+        # HP is tracked in integer guard-steps of damage so it never drifts with float sums.
+        self.damage_steps = 0
+        self.lethal_steps = round(self.hp_max / self.dt)
+
+        self.zones = self._zone_masks()
+        self.space = self._build_space()
+        self.step_index = 0
+        self.done = False
+        self.events: list[Event] = []
+        self.tick_events: list[Event] = []
+        self.sighting: int | None = None
+        self.seen_by: tuple[int, ...] = ()
+        self.sprinting = False
+        self.player_input: tuple[float, float] | None = None
+        self.on_tick: Callable[[World], None] | None = None
+
+        n = self.graph.n
+        self.m = Metrics(
+            covered=np.zeros(n, dtype=bool),
+            visits=np.zeros(n, dtype=np.int64),
+            attacks=np.zeros(n, dtype=np.float64),
+        )
+
+        guard_speed = float(w["guard_speed"])
+        player_speed = float(w["player_speed"]) * float(s["player_speed_scale"])
+        spawn_nodes = self._guard_spawn_nodes(int(w["guards"]), str(w["spawns"]))
+        self.guards = [self._make_agent(node, guard_speed) for node in spawn_nodes]
+        for guard in self.guards:
+            guard.heading = float(spawn_rng.uniform(-math.pi, math.pi))
+        self.player = self._make_agent(self.start_node(), player_speed)
+        self.player_speed = player_speed
+
+        self.guard_ai.reset(self.graph, guard_rng, len(self.guards))
+        if self.player_policy is not None:
+            self.player_policy.reset(self.graph, player_rng)
+        for guard in self.guards:
+            self._enter_node(guard, guard.node, count_visit=True)
+            guard.history.append(guard.node)
+        self.attackers = 0
+        self._sense()
+
+    # ------------------------------------------------------------------ construction
+    def _zone_masks(self) -> dict[str, np.ndarray]:
+        masks = {}
+        x, y = self.graph.positions[:, 0], self.graph.positions[:, 1]
+        for kind, polygons in self.level.zones.items():
+            mask = np.zeros(self.graph.n, dtype=bool)
+            for polygon in polygons:
+                mask |= shapely.intersects_xy(polygon, x, y)
+            masks[kind] = mask
+        return masks
+
+    def _build_space(self) -> pymunk.Space:
+        space = pymunk.Space()
+        space.gravity = (0.0, 0.0)
+        for (ax, ay), (bx, by) in self.level.walls:
+            wall = pymunk.Segment(space.static_body, (ax, ay), (bx, by), 0.0)
+            wall.filter = pymunk.ShapeFilter(categories=WALL_CATEGORY)
+            wall.friction = 0.0
+            wall.elasticity = 0.0
+            space.add(wall)
+        return space
+
+    def _make_agent(self, node: int, speed: float) -> Agent:
+        body = pymunk.Body(1.0, float("inf"))
+        shape = pymunk.Circle(body, self.radius)
+        shape.filter = AGENT_FILTER
+        shape.friction = 0.0
+        shape.elasticity = 0.0
+        self.space.add(body, shape)
+        agent = Agent(body=body, speed=speed, node=node, target=node)
+        agent.place(tuple(float(v) for v in self.graph.positions[node]))
+        return agent
+
+    def _guard_spawn_nodes(self, count: int, spawns: str) -> list[int]:
+        if spawns == "level":
+            return [self.graph.node_at(x, y) for x, y in self.level.guards]
+        if spawns != "random":
+            raise ValueError(f"world.spawns: expected 'random' or 'level', got {spawns!r}")
+        count = min(count, self.graph.n - 1)
+        return [int(v) for v in self.spawn_rng.choice(self.graph.n, size=count, replace=False)]
+
+    def start_node(self) -> int:
+        """SPEC §7: the node farthest (min shortest path) from every guard, out of their sight.
+
+        Nodes any active guard could see now are excluded unless that leaves none; ties are
+        broken with the trial's spawn generator.
+        """
+        active = [g for g in self.guards if g.active]
+        if not active:
+            return int(self.spawn_rng.integers(self.graph.n))
+        nodes = np.array([g.node for g in active])
+        score = self.graph.dist[nodes].min(axis=0)
+        visible = np.zeros(self.graph.n, dtype=bool)
+        for guard in active:
+            visible |= self._visible_nodes(guard)
+        if not visible.all():
+            score = np.where(visible, -np.inf, score)
+        best = np.flatnonzero(score >= score.max() - 1e-9)
+        return int(best[self.spawn_rng.integers(len(best))])
+
+    def _visible_nodes(self, guard: Agent) -> np.ndarray:
+        gx, gy = guard.pos
+        delta = self.graph.positions - (gx, gy)
+        dist = np.hypot(delta[:, 0], delta[:, 1])
+        hx, hy = math.cos(guard.heading), math.sin(guard.heading)
+        in_cone = (dist <= self.view_range) & (
+            delta @ (hx, hy) >= self.cos_half_fov * dist - 1e-12
+        )
+        for node in np.flatnonzero(in_cone):
+            if not self._clear_line((gx, gy), tuple(self.graph.positions[node])):
+                in_cone[node] = False
+        return in_cone
+
+    # ------------------------------------------------------------------ queries
+    def _clear_line(self, a: tuple[float, float], b: tuple[float, float]) -> bool:
+        return self.space.segment_query_first(a, b, 0.0, WALL_QUERY) is None
+
+    def sees(self, guard: Agent, target: tuple[float, float]) -> bool:
+        """Vision: within range (scaled by concealment), inside the cone, line of sight clear."""
+        if not guard.active:
+            return False
+        gx, gy = guard.pos
+        dx, dy = target[0] - gx, target[1] - gy
+        d2 = dx * dx + dy * dy
+        reach = self.view_range * self._concealment_factor() + RANGE_EPS
+        if d2 > reach * reach:
+            return False
+        d = math.sqrt(d2)
+        if d > 1e-9 and dx * math.cos(guard.heading) + dy * math.sin(guard.heading) < (
+            self.cos_half_fov * d
+        ):
+            return False
+        return self._clear_line((gx, gy), target)
+
+    def _concealment_factor(self) -> float:
+        mask = self.zones.get("concealment")
+        if mask is not None and mask[self.player.node]:
+            return self.concealment_view_scale
+        return 1.0
+
+    @property
+    def hp(self) -> float:
+        return self.hp_max - self.damage_steps * self.dt
+
+    @property
+    def t(self) -> float:
+        return self.step_index * self.dt
+
+    def view(self) -> WorldView:
+        """The snapshot the controllers read."""
+        return WorldView(
+            t=self.t,
+            graph=self.graph,
+            guard_nodes=np.array([g.node for g in self.guards], dtype=np.int64),
+            guard_positions=np.array([g.pos for g in self.guards], dtype=np.float64),
+            guard_headings=np.array([g.heading for g in self.guards], dtype=np.float64),
+            player_node=self.player.node,
+            player_pos=np.array(self.player.pos),
+            seen_by=self.seen_by,
+            sighting=self.sighting,
+            events=tuple(self.tick_events),
+            zones=self.zones,
+            guard_active=np.array([g.active for g in self.guards], dtype=bool),
+        )
+
+    # ------------------------------------------------------------------ movement
+    def _plan(self, agent: Agent, target: int) -> None:
+        """Waypoints from the agent's position to ``target``'s node position."""
+        goal = tuple(self.graph.positions[target])
+        agent.target, agent.since_target = target, 0.0
+        if self.graph.mesh is None or target == agent.node:
+            agent.waypoints = deque([goal])
+            return
+        if self.graph.kind == "grid":
+            path = self.graph.shortest_path(agent.node, target)
+            agent.waypoints = deque(tuple(self.graph.positions[v]) for v in path[1:])
+            return
+        points = self.graph.mesh.find_path(agent.pos, goal).points
+        agent.waypoints = deque(self._clear_corners(points))
+
+    def _clear_corners(self, points: np.ndarray) -> list[tuple[float, float]]:
+        """Move the funnel path's corner points one agent radius off the wall corner.
+
+        The funnel's interior points are wall vertices, which a body of radius r can never
+        reach; shifting each away from the corner along its bisector keeps the turn tight
+        without grinding the body along the wall.
+        """
+        out = []
+        for k in range(1, len(points) - 1):
+            p = points[k]
+            u = points[k - 1] - p
+            v = points[k + 1] - p
+            nu, nv = np.linalg.norm(u), np.linalg.norm(v)
+            if nu < 1e-9 or nv < 1e-9:
+                continue
+            bisector = u / nu + v / nv
+            norm = np.linalg.norm(bisector)
+            if norm < 1e-6:
+                out.append((float(p[0]), float(p[1])))
+                continue
+            shifted = p - bisector / norm * (self.radius + 0.02)
+            if self.level.contains(float(shifted[0]), float(shifted[1])):
+                p = shifted
+            out.append((float(p[0]), float(p[1])))
+        out.append((float(points[-1][0]), float(points[-1][1])))
+        return out
+
+    def _drive(self, agent: Agent, speed: float) -> None:
+        """Set the body's velocity towards its next waypoint, landing on it exactly."""
+        if not agent.active or not agent.waypoints:
+            agent.set_velocity((0.0, 0.0))
+            return
+        x, y = agent.pos
+        wx, wy = agent.waypoints[0]
+        dx, dy = wx - x, wy - y
+        d = math.hypot(dx, dy)
+        if d < 1e-12:
+            agent.set_velocity((0.0, 0.0))
+            return
+        step = speed * self.dt
+        if d <= step:
+            agent.set_velocity((dx / self.dt, dy / self.dt))
+        else:
+            agent.set_velocity((dx / d * speed, dy / d * speed))
+        agent.heading = math.atan2(dy, dx)
+
+    def _advance_waypoints(self, agent: Agent, moved: float, expected: float) -> None:
+        """Pop reached waypoints; a stalled agent close enough to one counts as arrived."""
+        while agent.waypoints:
+            x, y = agent.pos
+            wx, wy = agent.waypoints[0]
+            d = math.hypot(wx - x, wy - y)
+            stalled = moved < 0.25 * expected
+            if d <= ARRIVE_EPS or (stalled and d <= self.radius + 0.05):
+                agent.waypoints.popleft()
+                if not agent.waypoints:
+                    self._arrive(agent)
+                continue
+            break
+
+    def _arrive(self, agent: Agent) -> None:
+        """A guard reached its target: count a backtrack if it is among its last 5 nodes."""
+        if agent is self.player or agent.target == agent.history[-1]:
+            return  # the player is not scored; staying put is not a move
+        if agent.target in agent.history:
+            self.m.backtracks += 1
+        agent.history.append(agent.target)
+
+    def _enter_node(self, agent: Agent, node: int, count_visit: bool) -> None:
+        agent.node = node
+        if count_visit and agent is not self.player:
+            self.m.visits[node] += 1
+            self.m.covered[node] = True
+
+    # ------------------------------------------------------------------ the step
+    def step(self) -> None:
+        """Advance the world by one physics step (decisions, motion, senses, AI tick)."""
+        if self.done:
+            return
+        view = None
+        for i, guard in enumerate(self.guards):
+            if guard.active and guard.needs_decision:
+                view = view or self.view()
+                self._plan(guard, int(self.guard_ai.decide(i, view)))
+        if self.player_input is None and self.player_policy is not None and self.player.needs_decision:
+            view = view or self.view()
+            self._plan(self.player, int(self.player_policy.decide(view)))
+
+        for guard in self.guards:
+            self._drive(guard, guard.speed)
+        player_speed = self.player_speed * (self.sprint_factor if self.sprinting else 1.0)
+        if self.player_input is not None:
+            vx, vy = self.player_input
+            self.player.set_velocity((vx * player_speed, vy * player_speed))
+            if vx or vy:
+                self.player.heading = math.atan2(vy, vx)
+        else:
+            self._drive(self.player, player_speed)
+
+        before = [a.pos for a in self.guards] + [self.player.pos]
+        self.space.step(self.dt)
+        self.step_index += 1
+        if self.attackers:
+            # Guards in range at the start of the step hurt over the whole step, so a
+            # player in range from t0 on dies at exactly t0 + HP (per guard).
+            self.damage_steps += self.attackers
+            self.m.attacks[self.player.node] += self.attackers * self.dt
+            if self.damage_steps >= self.lethal_steps:
+                self._captured()
+
+        agents = self.guards + [self.player]
+        for agent, (bx, by), speed in zip(
+            agents, before, [g.speed for g in self.guards] + [player_speed]
+        ):
+            agent.sync()
+            x, y = agent.pos
+            moved = math.hypot(x - bx, y - by)
+            agent.since_target += self.dt
+            self._advance_waypoints(agent, moved, speed * self.dt)
+            node = self.graph.node_at(x, y)
+            if node != agent.node:
+                self._enter_node(agent, node, count_visit=True)
+            if agent.waypoints and agent.since_target > self.stuck_timeout:
+                agent.waypoints.clear()  # re-plan from where it stands
+
+        self._sense()
+        if self.step_index % self.steps_per_tick == 0:
+            self._ai_tick()
+        if self.step_index >= self.total_steps:
+            self.done = True
+
+    def _sense(self) -> None:
+        """Vision, attack damage, distance and detection metrics for the current positions."""
+        ppos = self.player.pos
+        self.seen_by = tuple(i for i, g in enumerate(self.guards) if self.sees(g, ppos))
+        if self.seen_by:
+            self.sighting = self.player.node
+            if self.m.first_detect_time is None:
+                self.m.first_detect_time = self.t
+
+        self.attackers = sum(1 for g in self.guards if g.active and self._in_attack_range(g))
+        active = [g.node for g in self.guards if g.active]
+        if active and self.step_index > 0:
+            self.m.dist_sum += float(self.graph.dist[active, self.player.node].min())
+            self.m.dist_samples += 1
+
+    def _in_attack_range(self, guard: Agent) -> bool:
+        gx, gy = guard.pos
+        px, py = self.player.pos
+        if math.hypot(gx - px, gy - py) > self.attack_range + RANGE_EPS:
+            return False
+        return not self.attack_los or self._clear_line((gx, gy), (px, py))
+
+    def _captured(self) -> None:
+        self.m.captures += 1
+        if self.m.capture_time is None:
+            self.m.capture_time = self.t
+        self.events.append(Event("capture", self.player.node, self.t))
+        if self.end_on_capture:
+            self.done = True
+            return
+        # Fixed-time scenario: respawn at a fresh start position with full HP.
+        self.damage_steps = 0
+        node = self.start_node()
+        self.player.place(tuple(float(v) for v in self.graph.positions[node]))
+        self.player.node = node
+        self.player.waypoints.clear()
+        self.events.append(Event("respawn", node, self.t))
+
+    def _ai_tick(self) -> None:
+        dt = self.steps_per_tick * self.dt
+        self.tick_events = self.events
+        self.guard_ai.tick(self.view(), dt)
+        self.events = []
+        self.sighting = None
+        if self.on_tick is not None:
+            self.on_tick(self)
+
+    # ------------------------------------------------------------------ results
+    def run(self) -> dict[str, Any]:
+        """Step until the trial ends; return its metrics."""
+        while not self.done:
+            self.step()
+        return self.metrics()
+
+    def metrics(self) -> dict[str, Any]:
+        """SPEC §9 metrics of the trial so far (times in seconds, None where nothing happened)."""
+        m = self.m
+        return {
+            "captured": m.captures > 0,
+            "capture_time": _round(m.capture_time),
+            "captures": m.captures,
+            "coverage": float(m.covered.mean()) if self.graph.n else 0.0,
+            "avg_guard_player_dist": m.dist_sum / m.dist_samples if m.dist_samples else None,
+            "first_detect_time": _round(m.first_detect_time),
+            "backtracks": m.backtracks,
+        }
+
+    def trace_record(self) -> dict[str, Any]:
+        """One trace line (SPEC §9): time, agents, who sees the player, HP, events."""
+        return {
+            "t": _round(self.t),
+            "player": {
+                "pos": [round(v, 4) for v in self.player.pos],
+                "hp": round(self.hp, 4),
+                "node": self.player.node,
+            },
+            "guards": [
+                {
+                    "pos": [round(v, 4) for v in g.pos],
+                    "heading": round(g.heading, 4),
+                    "sees_player": i in self.seen_by,
+                    "node": g.node,
+                    "target": g.target,
+                    "state": self.guard_ai.state_name(i),
+                    "active": g.active,
+                }
+                for i, g in enumerate(self.guards)
+            ],
+            "events": [
+                {"kind": e.kind, "node": e.node, "t": _round(e.t), **dict(e.data)}
+                for e in self.tick_events
+            ],
+        }
+
+
+def _round(value: float | None) -> float | None:
+    return None if value is None else round(value, 6)
+
+
+def default_rngs(seed: int) -> tuple[np.random.Generator, ...]:
+    """Three independent generators (spawns, guards, player) from one integer seed."""
+    children = np.random.SeedSequence(seed).spawn(3)
+    return tuple(np.random.Generator(np.random.PCG64(c)) for c in children)

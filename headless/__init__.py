@@ -1,0 +1,1 @@
+"""The ``stealth`` command line, sweeps, the results store and reports (drives ``game``)."""
