@@ -1,0 +1,1 @@
+"""Level geometry, triangulation, node graphs and pathfinding (imports nothing of ai/game/headless)."""
