@@ -84,7 +84,7 @@ def make_world(spec: TrialSpec, config: Config | None = None, **world_kwargs: An
         level,
         spec.abstraction,
         make_guard_ai(spec.guards, config.section(spec.guards)),
-        make_player_policy(spec.player, player_params(config)),
+        make_player_policy(spec.player, player_params(config, spec.scenario)),
         config=config,
         scenario=spec.scenario,
         rngs=trial_rngs(spec, level.name),
@@ -92,11 +92,13 @@ def make_world(spec: TrialSpec, config: Config | None = None, **world_kwargs: An
     )
 
 
-def player_params(config: Config) -> dict[str, Any]:
-    """What a player policy needs to know: its own section plus the agents' speeds."""
+def player_params(config: Config, scenario: str) -> dict[str, Any]:
+    """What a player policy needs: its own section plus both speeds in this scenario."""
     params = config.section("player")
     params["guard_speed"] = config["world.guard_speed"]
-    params["player_speed"] = config["world.player_speed"]
+    params["player_speed"] = (
+        config["world.player_speed"] * config[f"scenario.{scenario}.player_speed_scale"]
+    )
     return params
 
 

@@ -1,0 +1,295 @@
+"""The paper's baseline guards (SPEC §4): RandomWalk, Cheat, FSM and Staleness.
+
+FSM and Staleness share one state machine (:class:`ScriptedGuards`) and differ only in how
+a patrolling guard picks its next target. State changes and timers advance in ``tick`` (once
+per AI tick); ``decide`` only turns the current state into the next node, stepping along
+the shortest path by :func:`~ai.view.move_horizon` (one cell on the grid).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass
+from typing import Any, ClassVar
+
+import numpy as np
+
+from navmesh.graph import NodeGraph
+
+from .fields import active_guard_nodes, sighting_node
+from .params import FSMParams, StalenessParams
+from .view import GuardAI, WorldView, move_horizon
+
+PATROL, INVESTIGATE, CHASE, RETURN = "patrol", "investigate", "chase", "return"
+
+#: tolerance of timer comparisons, so 0.1-s ticks summed ten times still make 1 s
+_TIME_EPS = 1e-9
+
+
+class RandomWalkGuards(GuardAI):
+    """Each guard moves to a uniformly random neighbouring node at every decision."""
+
+    mode = "random"
+
+    def reset(self, graph: NodeGraph, rng: np.random.Generator, n_guards: int) -> None:
+        self.graph, self.rng = graph, rng
+
+    def decide(self, i: int, view: WorldView) -> int:
+        node = int(view.guard_nodes[i])
+        options = self.graph.neighbors[node]
+        if len(options) == 0:
+            return node
+        return int(options[self.rng.integers(len(options))])
+
+
+class CheatGuards(GuardAI):
+    """Every guard follows the shortest path to the player's true position (an upper bound)."""
+
+    mode = "cheat"
+
+    def reset(self, graph: NodeGraph, rng: np.random.Generator, n_guards: int) -> None:
+        self.graph = graph
+        self.horizon = move_horizon(graph, float(self.params.get("r_edge_factor", 2.5)))
+
+    def decide(self, i: int, view: WorldView) -> int:
+        return self.graph.step_towards(int(view.guard_nodes[i]), view.player_node, self.horizon)
+
+
+@dataclass
+class GuardState:
+    """One scripted guard's state and timers (seconds)."""
+
+    state: str = PATROL
+    time_in_state: float = 0.0
+    #: patrol target (kept across Investigate/Chase/Return so Patrol resumes it)
+    target: int | None = None
+    #: where the guard left its patrol; Return walks back here
+    route_node: int | None = None
+    #: Investigate: the last known position being searched
+    spot: int | None = None
+    #: Investigate: the guard has reached the spot
+    arrived: bool = False
+    #: Investigate: seconds searched, counted from the first AI tick at or after arrival
+    search_time: float | None = None
+    #: Chase: seconds since any guard last saw the player
+    unseen: float = 0.0
+    #: Return after Chase hit chase_max: the guard ignores the player until back on patrol
+    gave_up: bool = False
+
+
+class ScriptedGuards(GuardAI):
+    """Patrol → Investigate → Chase → Return → Patrol (paper Table 2; SPEC §4).
+
+    Rules, evaluated per guard at every AI tick (``tick``):
+
+    * **Chase** starts when *this* guard sees the player (from Patrol, Investigate, or a
+      Return that did not follow a give-up). The chaser heads for the team's last known
+      player node, updated whenever *any* guard sees the player (shared radio). It ends after
+      ``t_lose_sight`` with no sighting by any guard (a sighting between two ticks
+      counts), or after ``chase_max`` in Chase; then **Return**. A guard that sees the
+      player when it decides switches to Chase at once; all other changes happen in
+      ``tick``.
+    * **Investigate** starts on information of strength ≥ ``info_threshold``: a sighting by
+      any guard since the last tick (strength ``sighting_information``) or a stimulus layer
+      whose magnitude at the guard's node, ``|extra_information[node]|``, reaches the
+      threshold (the guard then investigates the layer's strongest node). The guard walks
+      to the spot, then searches around it (random steps within one hop) for
+      ``t_investigate`` seconds counted from its arrival; then **Return**.
+    * **Return** walks back to where the guard left its patrol, for at most ``return_max``
+      seconds (or until it is there); then **Patrol** resumes the old target.
+    """
+
+    mode = ""
+    config_type: ClassVar[type[FSMParams]] = FSMParams
+
+    def __init__(self, params: Mapping[str, Any] | None = None) -> None:
+        super().__init__(params)
+        self.config = self.config_type.from_mapping(self.params)
+
+    def reset(self, graph: NodeGraph, rng: np.random.Generator, n_guards: int) -> None:
+        self.graph, self.rng, self.n_guards = graph, rng, n_guards
+        self.horizon = move_horizon(graph, self.config.r_edge_factor)
+        self.guards = [GuardState() for _ in range(n_guards)]
+        self.last_known: int | None = None
+        self._extra = np.zeros(graph.n)
+
+    # ------------------------------------------------------------------ stimuli hook
+    @property
+    def extra_information(self) -> np.ndarray:
+        """Stimulus information layers (n,), ≤ 0 for attractive stimuli; zeros by default.
+
+        Same hook as the PF guards': the stimulus module assigns the sum of its layers. A
+        guard whose node has ``|layer| ≥ info_threshold`` investigates the layer's minimum.
+        """
+        return self._extra
+
+    @extra_information.setter
+    def extra_information(self, values: np.ndarray) -> None:
+        values = np.array(values, dtype=np.float64)
+        if values.shape != (self.graph.n,):
+            raise ValueError(
+                f"extra_information must have shape ({self.graph.n},), got {values.shape}"
+            )
+        self._extra = values
+
+    # ------------------------------------------------------------------ timers and states
+    def tick(self, view: WorldView, dt: float) -> None:
+        """Advance every guard's timers and switch states (see the class docstring)."""
+        c = self.config
+        seen_by = set(view.seen_by)
+        sighting = sighting_node(view)
+        if sighting is not None:
+            self.last_known = sighting
+        stimulus_source = (
+            int(np.argmin(self._extra)) if self._extra.size and self._extra.min() < 0 else None
+        )
+        active = view.guard_active
+        for i, gs in enumerate(self.guards):
+            if active is not None and not active[i]:
+                continue
+            node = int(view.guard_nodes[i])
+            gs.time_in_state += dt
+            if gs.state == CHASE:
+                gs.unseen = 0.0 if sighting is not None else gs.unseen + dt
+                if gs.unseen >= c.t_lose_sight - _TIME_EPS:
+                    self._enter(gs, RETURN, node)
+                elif gs.time_in_state >= c.chase_max - _TIME_EPS:
+                    self._enter(gs, RETURN, node)
+                    gs.gave_up = True
+                continue
+            deaf = gs.state == RETURN and gs.gave_up
+            if i in seen_by and not deaf:
+                self._enter(gs, CHASE, node)
+                continue
+            info_node = None
+            if sighting is not None and c.sighting_information >= c.info_threshold:
+                info_node = sighting
+            elif stimulus_source is not None and -self._extra[node] >= c.info_threshold:
+                info_node = stimulus_source
+            if info_node is not None and not deaf:
+                if gs.state != INVESTIGATE or gs.spot != info_node:
+                    self._enter(gs, INVESTIGATE, node)
+                    gs.spot = info_node
+                # fresh information restarts the search (and the walk, unless already there)
+                gs.arrived, gs.search_time = node == info_node, None
+            if gs.state == INVESTIGATE:
+                gs.arrived = gs.arrived or node == gs.spot
+                if gs.arrived:
+                    gs.search_time = 0.0 if gs.search_time is None else gs.search_time + dt
+                    if gs.search_time >= c.t_investigate - _TIME_EPS:
+                        self._enter(gs, RETURN, node)
+            elif gs.state == RETURN and (
+                gs.time_in_state >= c.return_max - _TIME_EPS or node == gs.route_node
+            ):
+                self._enter(gs, PATROL, node)
+
+    @staticmethod
+    def _enter(gs: GuardState, state: str, node: int) -> None:
+        if (gs.state == PATROL and state != PATROL) or gs.route_node is None:
+            gs.route_node = node  # where the guard leaves its patrol
+        gs.state, gs.time_in_state = state, 0.0
+        gs.unseen, gs.gave_up = 0.0, False
+        gs.spot, gs.arrived, gs.search_time = None, False, None
+
+    # ------------------------------------------------------------------ movement
+    def decide(self, i: int, view: WorldView) -> int:
+        """The next node for guard ``i``'s current state, one move horizon along its path."""
+        gs = self.guards[i]
+        node = int(view.guard_nodes[i])
+        if view.seen_by:
+            self.last_known = int(view.player_node)
+        self._visit(node)
+        if i in view.seen_by and gs.state != CHASE and not (gs.state == RETURN and gs.gave_up):
+            self._enter(gs, CHASE, node)  # seeing the player needs no timer: chase at once
+        if gs.state == CHASE:
+            goal = self.last_known if self.last_known is not None else node
+        elif gs.state == INVESTIGATE and gs.spot is not None:
+            gs.arrived = gs.arrived or node == gs.spot
+            goal = self._look_around(gs.spot, node) if gs.arrived else gs.spot
+        elif gs.state == RETURN and gs.route_node is not None and node != gs.route_node:
+            goal = gs.route_node
+        else:
+            if gs.target is None or node == gs.target:
+                gs.target = self._patrol_target(i, node)
+            goal = gs.target
+        return self.graph.step_towards(node, goal, self.horizon)
+
+    def _look_around(self, spot: int, node: int) -> int:
+        """A random node within one hop of the investigated spot, other than where the guard is."""
+        around = np.append(self.graph.neighbors[spot], spot)
+        around = around[around != node]
+        return int(around[self.rng.integers(len(around))]) if len(around) else node
+
+    def _taken_targets(self, i: int) -> list[int]:
+        return [g.target for j, g in enumerate(self.guards) if j != i and g.target is not None]
+
+    def _visit(self, node: int) -> None:
+        """Hook: a guard stands on ``node`` (Staleness resets it)."""
+
+    def _patrol_target(self, i: int, node: int) -> int:
+        raise NotImplementedError
+
+    def state_name(self, i: int) -> str:
+        """patrol / investigate / chase / return."""
+        return self.guards[i].state
+
+
+class FSMGuards(ScriptedGuards):
+    """FSM baseline: patrols random reachable targets (uniform, never another guard's)."""
+
+    mode = "fsm"
+    config_type = FSMParams
+
+    def _patrol_target(self, i: int, node: int) -> int:
+        allowed = np.isfinite(self.graph.dist[node])
+        allowed[node] = False
+        allowed[self._taken_targets(i)] = False
+        options = np.flatnonzero(allowed)
+        return int(options[self.rng.integers(len(options))]) if len(options) else node
+
+
+class StalenessGuards(ScriptedGuards):
+    """Staleness baseline: patrols to the stalest node (time since any guard stood there).
+
+    Staleness grows by ``increment`` per second of AI tick (``increment × dt``) and is reset
+    to 0 on every active guard's node at each tick and on a guard's node whenever it
+    decides (so cells a guard walks through between ticks count as visited). The target is
+    the stalest reachable node that no other guard is heading for; ties are drawn with the
+    trial's generator.
+    """
+
+    mode = "staleness"
+    config_type = StalenessParams
+
+    def reset(self, graph: NodeGraph, rng: np.random.Generator, n_guards: int) -> None:
+        super().reset(graph, rng, n_guards)
+        self.staleness = np.zeros(graph.n)
+
+    def tick(self, view: WorldView, dt: float) -> None:
+        """Staleness grows by ``increment × dt`` and resets under the guards; then the FSM tick."""
+        self.staleness += self.config.increment * dt  # type: ignore[attr-defined]
+        self.staleness[active_guard_nodes(view)] = 0.0
+        super().tick(view, dt)
+
+    def _visit(self, node: int) -> None:
+        self.staleness[node] = 0.0
+
+    def _patrol_target(self, i: int, node: int) -> int:
+        values = np.where(np.isfinite(self.graph.dist[node]), self.staleness, -np.inf)
+        values[node] = -np.inf
+        values[self._taken_targets(i)] = -np.inf
+        best = values.max()
+        if not np.isfinite(best):
+            return node
+        stalest = np.flatnonzero(values >= best - 1e-9)
+        return int(stalest[self.rng.integers(len(stalest))])
+
+
+__all__ = [
+    "RandomWalkGuards",
+    "CheatGuards",
+    "FSMGuards",
+    "StalenessGuards",
+    "ScriptedGuards",
+    "GuardState",
+]

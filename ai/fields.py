@@ -1,0 +1,393 @@
+"""The composite potential field of the guard team (paper §Methods; SPEC §3).
+
+Everything that depends only on the graph and the parameters — ``γ_I^hops``, ``γ_C^hops``,
+the row-normalised kernel matrix, the connectivity field and the candidate sets — is
+computed once per :class:`~navmesh.graph.NodeGraph` and cached, because thousands of trials
+reuse one graph. A tick and a decision are then a handful of numpy vector operations and one
+sparse matrix-vector product; there is no per-node Python loop (SPEC §3.8).
+
+State arrays are never modified in place: every tick makes new arrays and marks them
+read-only, so references handed out by :meth:`CompositeField.fields` or kept for
+``explain()`` stay valid snapshots.
+
+>>> import numpy as np
+>>> from navmesh.graph import NodeGraph
+>>> field = CompositeField(NodeGraph.from_grid(np.ones((1, 5), bool), 1.0))
+>>> field.tick(1.0, guard_nodes=[4], sighting_node=0)
+>>> field.information.round(4).tolist()
+[-5.0, -4.5, -4.05, -3.645, -3.2805]
+>>> field.choose(2, np.random.default_rng(0))  # towards the sighting, away from the guard
+1
+"""
+
+from __future__ import annotations
+
+import weakref
+from collections.abc import Sequence
+from dataclasses import dataclass
+from typing import NamedTuple
+
+import numpy as np
+from scipy import sparse
+
+from navmesh.graph import UNREACHABLE_HOPS, NodeGraph
+
+from .params import PFParams
+from .view import WorldView
+
+# ---------------------------------------------------------------------------- precomputation
+
+
+@dataclass(frozen=True, eq=False)
+class FieldMatrices:
+    """What never changes for one graph and one parameter set; shared by every trial on it."""
+
+    #: (n, n) ``γ_I ** hops``: row p is the information spread of a sighting at p (0 if unreachable)
+    info_spread: np.ndarray
+    #: (n, n) ``γ_C ** hops``: row g is one guard's confidence deposit from node g
+    conf_spread: np.ndarray
+    #: (n, n) CSR, ``K[x, y] = λ^d(x,y) / Σ_{d(x,z) ≤ δ} λ^d(x,z)`` for ``d(x, y) ≤ δ``, else 0
+    kernel: sparse.csr_matrix
+    #: (n, n) row g = the kernel-smoothed deposit ``Kmat @ γ_C^d(g, ·)`` of a guard standing at g
+    presence: np.ndarray
+    #: (n,) ``κ − degree`` with κ the graph's maximum degree
+    connectivity: np.ndarray
+    #: per node, the nodes a guard standing there may choose (SPEC §3.5)
+    candidates: tuple[np.ndarray, ...]
+    #: partition candidate horizon in world units (``r_edge_factor × mean edge length``)
+    r_edge: float
+
+
+_MATRIX_CACHE: weakref.WeakKeyDictionary[NodeGraph, dict[tuple[float, ...], FieldMatrices]] = (
+    weakref.WeakKeyDictionary()
+)
+
+
+def field_matrices(graph: NodeGraph, params: PFParams) -> FieldMatrices:
+    """The precomputed matrices of ``graph`` for ``params``, built on first use and cached.
+
+    The cache holds the graph weakly, so a graph that is no longer used frees its matrices.
+    """
+    key = (
+        params.gamma_I,
+        params.gamma_C,
+        params.kernel_lambda,
+        float(params.kernel_radius),
+        params.r_edge_factor,
+    )
+    per_graph = _MATRIX_CACHE.setdefault(graph, {})
+    matrices = per_graph.get(key)
+    if matrices is None:
+        hops = graph.hops.astype(np.float64)
+        reachable = graph.hops < UNREACHABLE_HOPS
+        info_spread = np.where(reachable, params.gamma_I**hops, 0.0)
+        conf_spread = np.where(reachable, params.gamma_C**hops, 0.0)
+        degree = np.asarray(graph.degree, dtype=np.float64)
+        connectivity = graph.max_degree - degree
+        r_edge = params.r_edge_factor * graph.mean_edge_length
+        kernel = kernel_matrix(graph.hops, params.kernel_lambda, params.kernel_radius)
+        presence = np.ascontiguousarray(np.asarray(kernel @ conf_spread).T)
+        matrices = FieldMatrices(
+            info_spread=_read_only(info_spread),
+            conf_spread=_read_only(conf_spread),
+            kernel=kernel,
+            presence=_read_only(presence),
+            connectivity=_read_only(connectivity),
+            candidates=candidate_sets(graph, params.r_edge_factor),
+            r_edge=r_edge,
+        )
+        per_graph[key] = matrices
+    return matrices
+
+
+def kernel_matrix(hops: np.ndarray, lam: float, radius: int) -> sparse.csr_matrix:
+    """Row-normalised smoothing kernel ``λ^d / Σ λ^d`` over the hop ball of ``radius``."""
+    rows, cols = np.nonzero(hops <= radius)
+    weights = lam ** hops[rows, cols].astype(np.float64)
+    totals = np.bincount(rows, weights=weights, minlength=len(hops))
+    n = len(hops)
+    return sparse.csr_matrix((weights / totals[rows], (rows, cols)), shape=(n, n))
+
+
+def candidate_sets(graph: NodeGraph, r_edge_factor: float) -> tuple[np.ndarray, ...]:
+    """Per node, the nodes a guard there may choose next (SPEC §3.5).
+
+    Grid: the 4-neighbours. Partition: the frontier of a metric search (Dijkstra) from the
+    node at ``R = r_edge_factor × mean edge length`` — every node v with ``dist(s, v) ≥ R``
+    reached over a shortest-path edge (u, v) whose start is still inside, ``dist(s, u) < R``;
+    the adjacent nodes when that frontier is empty (the whole reachable graph lies within R).
+    """
+    neighbours = tuple(np.asarray(nb, dtype=np.intp) for nb in graph.neighbors)
+    if graph.kind == "grid":
+        return neighbours
+    r_edge = r_edge_factor * graph.mean_edge_length
+    if graph.n == 0 or r_edge <= 0:
+        return neighbours
+    coo = graph.adjacency.tocoo()
+    u, v, w = coo.row, coo.col, coo.data
+    result: list[np.ndarray] = []
+    chunk = 256
+    for start in range(0, graph.n, chunk):
+        du = graph.dist[start : start + chunk][:, u]
+        dv = graph.dist[start : start + chunk][:, v]
+        tol = 1e-9 * (1.0 + np.abs(dv))
+        frontier = (du < r_edge) & (dv >= r_edge) & (np.abs(du + w - dv) <= tol)
+        for row, s in zip(frontier, range(start, min(start + chunk, graph.n)), strict=True):
+            found = np.unique(v[row]).astype(np.intp)
+            result.append(found if len(found) else neighbours[s])
+    return tuple(result)
+
+
+def _read_only(array: np.ndarray) -> np.ndarray:
+    array.flags.writeable = False
+    return array
+
+
+# ---------------------------------------------------------------------------- reading a view
+
+
+def active_guard_nodes(view: WorldView) -> np.ndarray:
+    """Nodes of the guards still in play (a guard taken down deposits no confidence)."""
+    nodes = np.asarray(view.guard_nodes, dtype=np.intp)
+    if view.guard_active is None:
+        return nodes
+    return nodes[np.asarray(view.guard_active, dtype=bool)]
+
+
+def sighting_node(view: WorldView) -> int | None:
+    """The player's node if a guard sees it now, else ``view.sighting`` (None: not seen)."""
+    if view.seen_by:
+        return int(view.player_node)
+    return None if view.sighting is None else int(view.sighting)
+
+
+# ---------------------------------------------------------------------------- the field
+
+
+class Choice(NamedTuple):
+    """One argmin decision: the winner, the candidates with their K, and the tied ones."""
+
+    winner: int
+    candidates: np.ndarray
+    scores: np.ndarray
+    tied: np.ndarray
+
+
+class CompositeField:
+    """Shared I, C, N fields, adaptive weights, composite potential P and kernel K.
+
+    Equation numbers as in docs/ai.md (the paper's Methods order): ``I ≤ 0`` attractive
+    information (eqs. 1–2), ``C ≥ 0`` repulsive confidence (eq. 3), ``N = κ − degree``
+    (eq. 4), ``P = w_I (I + I_extra) + w_C C + w_N N`` (eq. 5), ``K = Kmat @ P`` (eq. 6), a
+    guard moves to ``argmin K`` over its candidates (eq. 7), weights per eq. 8.
+    ``I_extra`` (:attr:`extra_information`) and :attr:`confidence_decay` are the hooks for
+    stimuli and zones; ``select(..., teammates)`` adds the teammate-presence term.
+    """
+
+    def __init__(self, graph: NodeGraph, params: PFParams | None = None) -> None:
+        self.graph = graph
+        self.params = params or PFParams()
+        self.matrices = field_matrices(graph, self.params)
+        self.reset()
+
+    # ------------------------------------------------------------------ state
+    def reset(self) -> None:
+        """Empty fields, patrol weights, the global decay everywhere."""
+        n = self.graph.n
+        zeros = _read_only(np.zeros(n))
+        self._information = zeros
+        self._confidence = zeros
+        self._extra = zeros
+        self._confidence_decay = _read_only(np.full(n, self.params.rho))
+        self._decay_cache: tuple[float, np.ndarray, np.ndarray] | None = None
+        self._set_w_I(self.params.w_I_base)
+        self.ticks = 0
+        self._version = 0
+        self._cached_version = -1
+        self._potential = zeros
+        self._kernel = zeros
+
+    @property
+    def information(self) -> np.ndarray:
+        """I (n,), ≤ 0: the sighting field, decayed by ρ per second (read-only array)."""
+        return self._information
+
+    @property
+    def confidence(self) -> np.ndarray:
+        """C (n,), ≥ 0: where guards have recently been (read-only array)."""
+        return self._confidence
+
+    @property
+    def connectivity(self) -> np.ndarray:
+        """N (n,) = κ − degree, static (read-only array)."""
+        return self.matrices.connectivity
+
+    @property
+    def extra_information(self) -> np.ndarray:
+        """I_extra (n,): temporary information layers of stimuli, added to I inside P.
+
+        The stimulus module owns it: it assigns the sum of its active layers (≤ 0 for
+        attractive stimuli) after each tick, e.g. ``field.extra_information = layers``.
+        Zeros by default. The returned array is read-only; assign a new one to change it.
+        """
+        return self._extra
+
+    @extra_information.setter
+    def extra_information(self, values: np.ndarray) -> None:
+        values = np.array(values, dtype=np.float64)
+        if values.shape != (self.graph.n,):
+            raise ValueError(
+                f"extra_information must have shape ({self.graph.n},), got {values.shape}"
+            )
+        self._extra = _read_only(values)
+        self._version += 1
+
+    @property
+    def confidence_decay(self) -> np.ndarray:
+        """Per-node temporal decay of C per second: ρ everywhere unless overridden (read-only)."""
+        return self._confidence_decay
+
+    @confidence_decay.setter
+    def confidence_decay(self, values: np.ndarray) -> None:
+        values = np.array(np.broadcast_to(values, (self.graph.n,)), dtype=np.float64)
+        if np.any(values <= 0) or np.any(values > 1):
+            raise ValueError("confidence_decay values must be in (0, 1]")
+        self._confidence_decay = _read_only(values)
+        self._decay_cache = None
+
+    def set_confidence_decay(self, nodes: np.ndarray | Sequence[int], rate: float) -> None:
+        """Override the confidence decay of ``nodes`` (indices or a mask), e.g. dark cells 0.80."""
+        values = self._confidence_decay.copy()
+        values[np.asarray(nodes)] = rate
+        self.confidence_decay = values
+
+    @property
+    def weights(self) -> tuple[float, float, float]:
+        """(w_I, w_C, w_N), summing to 1."""
+        return self.w_I, self.w_C, self.w_N
+
+    def _set_w_I(self, w_I: float) -> None:  # noqa: N802, N803 — the paper's symbol
+        p = self.params
+        self.w_I = float(w_I)
+        rest = 1.0 - self.w_I
+        self.w_C = rest * p.w_C_patrol / (p.w_C_patrol + p.w_N_patrol)
+        self.w_N = rest * p.w_N_patrol / (p.w_C_patrol + p.w_N_patrol)
+
+    # ------------------------------------------------------------------ the AI tick
+    def tick(
+        self, dt: float, guard_nodes: Sequence[int] | np.ndarray, sighting_node: int | None
+    ) -> None:
+        """Advance the fields and weights by one AI tick of ``dt`` seconds (eqs. 1–3, 8).
+
+        ``guard_nodes`` are the active guards' nodes; ``sighting_node`` the player's node if
+        any guard saw the player since the last tick, else None.
+        """
+        if dt < 0:
+            raise ValueError(f"dt must be >= 0, got {dt}")
+        p, m = self.params, self.matrices
+        if sighting_node is not None:
+            information = -p.I0 * m.info_spread[sighting_node]
+            self._set_w_I(p.w_I_max)
+        else:
+            information = self._information * (p.rho**dt)
+            self._set_w_I(max(p.w_I_base, self.w_I - p.weight_decay * dt))
+        confidence = self._confidence * self._decay_power(dt)
+        guards = np.asarray(guard_nodes, dtype=np.intp)
+        if len(guards):
+            confidence = confidence + p.C0 * m.conf_spread[guards].sum(axis=0)
+        self._information = _read_only(information)
+        self._confidence = _read_only(confidence)
+        self.ticks += 1
+        self._version += 1
+
+    def _decay_power(self, dt: float) -> np.ndarray:
+        """``confidence_decay ** dt``, cached for the last dt (ticks are usually all 1 s)."""
+        cache = self._decay_cache
+        if cache is None or cache[0] != dt or cache[1] is not self._confidence_decay:
+            cache = (dt, self._confidence_decay, self._confidence_decay**dt)
+            self._decay_cache = cache
+        return cache[2]
+
+    # ------------------------------------------------------------------ potential and kernel
+    def _refresh(self) -> None:
+        if self._cached_version != self._version:
+            potential = (
+                self.w_I * (self._information + self._extra)
+                + self.w_C * self._confidence
+                + self.w_N * self.matrices.connectivity
+            )
+            self._potential = _read_only(potential)
+            self._kernel = _read_only(self.matrices.kernel @ potential)
+            self._cached_version = self._version
+
+    def potential(self) -> np.ndarray:
+        """P (n,) = w_I (I + I_extra) + w_C C + w_N N (eq. 5); cached until the state changes."""
+        self._refresh()
+        return self._potential
+
+    def kernel(self) -> np.ndarray:
+        """K (n,) = kernel-smoothed P (eq. 6); cached until the state changes."""
+        self._refresh()
+        return self._kernel
+
+    def candidates(self, node: int) -> np.ndarray:
+        """The nodes a guard at ``node`` may choose (SPEC §3.5)."""
+        return self.matrices.candidates[node]
+
+    def select(
+        self, node: int, rng: np.random.Generator, teammates: Sequence[int] | np.ndarray = ()
+    ) -> Choice:
+        """argmin K over the candidates of ``node`` (eq. 7); ties within tie_eps drawn with ``rng``.
+
+        ``teammates`` are the other active guards' current nodes: their presence term
+        ``w_C · teammate_presence · C0 · (Kmat @ γ_C^d(g, ·))`` is added to K (docs/ai.md).
+        """
+        candidates = self.matrices.candidates[node]
+        if len(candidates) == 0:
+            empty = np.zeros(0, dtype=np.intp)
+            return Choice(int(node), empty, np.zeros(0), empty)
+        scores = self.kernel()[candidates]
+        scale = self.w_C * self.params.teammate_presence * self.params.C0
+        if len(teammates) and scale:
+            presence = self.matrices.presence[np.asarray(teammates, dtype=np.intp)]
+            scores = scores + scale * presence[:, candidates].sum(axis=0)
+        tied = candidates[scores - scores.min() < self.params.tie_eps]
+        winner = tied[0] if len(tied) == 1 else tied[rng.integers(len(tied))]
+        return Choice(int(winner), candidates, scores, tied)
+
+    def choose(
+        self, node: int, rng: np.random.Generator, teammates: Sequence[int] | np.ndarray = ()
+    ) -> int:
+        """The next node of a guard at ``node``: :meth:`select`'s winner."""
+        return self.select(node, rng, teammates).winner
+
+    def teammate_confidence(self, teammates: Sequence[int] | np.ndarray) -> np.ndarray:
+        """C_live (n,): teammates' deposit at their current nodes × teammate_presence."""
+        live = np.zeros(self.graph.n)
+        if len(teammates):
+            live = self.matrices.conf_spread[np.asarray(teammates, dtype=np.intp)].sum(axis=0)
+        return self.params.teammate_presence * self.params.C0 * live
+
+    def fields(self) -> dict[str, np.ndarray]:
+        """Current I, I_extra, C, N, P, K (read-only arrays), e.g. for the game overlay."""
+        self._refresh()
+        return {
+            "I": self._information,
+            "I_extra": self._extra,
+            "C": self._confidence,
+            "N": self.matrices.connectivity,
+            "P": self._potential,
+            "K": self._kernel,
+        }
+
+
+__all__ = [
+    "CompositeField",
+    "Choice",
+    "FieldMatrices",
+    "field_matrices",
+    "kernel_matrix",
+    "candidate_sets",
+    "active_guard_nodes",
+    "sighting_node",
+]

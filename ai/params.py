@@ -1,0 +1,191 @@
+"""Parameters of the guard modes and player policies (paper Table 2, SPEC §3–§4).
+
+Every controller receives its parameters as a plain dict (from the config file's section of
+its mode) and turns it into one of these frozen dataclasses with ``from_mapping``, so a typo
+or an out-of-range value fails when the controller is built, not silently in a sweep.
+
+>>> PFParams.from_mapping({"rho": 0.9}).rho
+0.9
+>>> PFParams.from_mapping({"roh": 0.9})
+Traceback (most recent call last):
+...
+ValueError: PFParams: unknown parameter 'roh' (known: I0, C0, gamma_I, gamma_C, rho, ...)
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping
+from dataclasses import dataclass, fields
+from typing import Any, TypeVar
+
+_P = TypeVar("_P", bound="_Params")
+
+
+class _Params:
+    """Shared ``from_mapping`` and range checks of the parameter dataclasses."""
+
+    #: name -> (low, high, low_inclusive, high_inclusive); checked in ``__post_init__``
+    _ranges: dict[str, tuple[float, float, bool, bool]] = {}
+
+    @classmethod
+    def from_mapping(cls: type[_P], params: Mapping[str, Any] | None = None) -> _P:
+        """Defaults overridden by ``params``; an unknown key or a bad value raises ValueError."""
+        known = [f.name for f in fields(cls)]  # type: ignore[arg-type]
+        values: dict[str, Any] = {}
+        for key, value in dict(params or {}).items():
+            if key not in known:
+                shown = ", ".join(known[:5]) + (", ..." if len(known) > 5 else "")
+                raise ValueError(f"{cls.__name__}: unknown parameter {key!r} (known: {shown})")
+            values[key] = value
+        return cls(**values)
+
+    def __post_init__(self) -> None:
+        for f in fields(self):  # type: ignore[arg-type]
+            value = getattr(self, f.name)
+            kind = f.type if isinstance(f.type, str) else getattr(f.type, "__name__", "")
+            if kind == "bool":
+                if not isinstance(value, bool):
+                    raise ValueError(
+                        f"{type(self).__name__}: {f.name} must be true or false, got {value!r}"
+                    )
+                continue
+            if isinstance(value, bool) or not isinstance(value, (int, float)):
+                raise ValueError(f"{type(self).__name__}: {f.name} must be a number, got {value!r}")
+            if not math.isfinite(value):
+                raise ValueError(f"{type(self).__name__}: {f.name} must be finite, got {value!r}")
+            if kind == "int":
+                if int(value) != value:
+                    raise ValueError(
+                        f"{type(self).__name__}: {f.name} must be a whole number, got {value!r}"
+                    )
+                object.__setattr__(self, f.name, int(value))
+            elif kind == "float":
+                object.__setattr__(self, f.name, float(value))
+            if f.name in self._ranges:
+                low, high, low_in, high_in = self._ranges[f.name]
+                ok_low = value >= low if low_in else value > low
+                ok_high = value <= high if high_in else value < high
+                if not (ok_low and ok_high):
+                    span = f"{'[' if low_in else '('}{low}, {high}{']' if high_in else ')'}"
+                    raise ValueError(
+                        f"{type(self).__name__}: {f.name} must be in {span}, got {value!r}"
+                    )
+
+
+_UNIT = (0.0, 1.0, False, True)  # (0, 1]
+_POSITIVE = (0.0, math.inf, False, False)
+_NON_NEGATIVE = (0.0, math.inf, True, False)
+
+
+@dataclass(frozen=True)
+class PFParams(_Params):
+    """Composite potential field guards (paper Table 2, SPEC §3)."""
+
+    I0: float = 5.0  # noqa: N815 — the paper's symbol
+    C0: float = 1.0  # noqa: N815
+    gamma_I: float = 0.9  # noqa: N815 — spatial decay of the information field per hop
+    gamma_C: float = 0.8  # noqa: N815 — spatial decay of a guard's confidence deposit per hop
+    rho: float = 0.95  # temporal decay of I and C per second
+    kernel_lambda: float = 0.8
+    kernel_radius: int = 3  # hops
+    w_I_base: float = 0.4  # noqa: N815
+    w_C_patrol: float = 0.5  # noqa: N815
+    w_N_patrol: float = 0.1  # noqa: N815
+    w_I_max: float = 0.9  # noqa: N815
+    weight_decay: float = 0.05  # of w_I, per second
+    r_edge_factor: float = 2.5  # partition candidate horizon = factor × mean edge length
+    tie_eps: float = 1e-9
+    #: scale of the teammates' confidence deposit at their *current* nodes, added when a guard
+    #: decides (docs/ai.md "Teammate presence"); 0 = the paper's field only
+    teammate_presence: float = 1.0
+
+    _ranges = {
+        "teammate_presence": _NON_NEGATIVE,
+        "I0": _NON_NEGATIVE,
+        "C0": _NON_NEGATIVE,
+        "gamma_I": _UNIT,
+        "gamma_C": _UNIT,
+        "rho": _UNIT,
+        "kernel_lambda": _UNIT,
+        "kernel_radius": (0, math.inf, True, False),
+        "w_I_base": (0.0, 1.0, True, True),
+        "w_C_patrol": _NON_NEGATIVE,
+        "w_N_patrol": _NON_NEGATIVE,
+        "w_I_max": (0.0, 1.0, True, True),
+        "weight_decay": _NON_NEGATIVE,
+        "r_edge_factor": _POSITIVE,
+        "tie_eps": _NON_NEGATIVE,
+    }
+
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        if self.w_I_max < self.w_I_base:
+            raise ValueError(
+                f"PFParams: w_I_max ({self.w_I_max}) must be >= w_I_base ({self.w_I_base})"
+            )
+        if self.w_C_patrol + self.w_N_patrol <= 0:
+            raise ValueError("PFParams: w_C_patrol + w_N_patrol must be > 0")
+
+
+@dataclass(frozen=True)
+class FSMParams(_Params):
+    """FSM guards (paper Table 2; SPEC §4). Times in seconds."""
+
+    info_threshold: float = 1.0  # information strength that triggers Investigate
+    #: strength of a sighting reported by any guard (the PF's I0, so both modes get the same signal)
+    sighting_information: float = 5.0
+    t_investigate: float = 3.0  # time spent searching at the last known position
+    t_lose_sight: float = 2.0  # Chase gives up after this long with no guard seeing the player
+    chase_max: float = 10.0
+    return_max: float = 5.0
+    r_edge_factor: float = 2.5  # partition step horizon = factor × mean edge length
+
+    _ranges = {
+        "info_threshold": _NON_NEGATIVE,
+        "sighting_information": _NON_NEGATIVE,
+        "t_investigate": _NON_NEGATIVE,
+        "t_lose_sight": _NON_NEGATIVE,
+        "chase_max": _NON_NEGATIVE,
+        "return_max": _NON_NEGATIVE,
+        "r_edge_factor": _POSITIVE,
+    }
+
+
+@dataclass(frozen=True)
+class StalenessParams(FSMParams):
+    """Staleness guards: the FSM's parameters plus the staleness growth per second of AI tick."""
+
+    increment: float = 1.0
+
+    _ranges = {**FSMParams._ranges, "increment": _NON_NEGATIVE}
+
+
+@dataclass(frozen=True)
+class PlayerParams(_Params):
+    """Scripted players (SPEC §4). Speeds in world units per second, margins in seconds."""
+
+    maxmin_depth: int = 3  # steps simulated ahead (≤ 5^depth sequences on the grid)
+    #: MaxMin assumes every guard closes in by one guard step per player step (pessimistic)
+    maxmin_guards_advance: bool = True
+    guard_speed: float = 2.0
+    player_speed: float = 2.0
+    #: SafetyGraph: a node is safe when the player gets there this many seconds before any guard
+    safety_margin: float = 1.0
+    #: SafetyGraph: edge cost factor 1 + safety_penalty × max(0, safety_margin − S) (per second)
+    safety_penalty: float = 4.0
+    r_edge_factor: float = 2.5  # partition step horizon of SafetyGraph
+    tie_eps: float = 1e-9
+
+    _ranges = {
+        "maxmin_depth": (1, 6, True, True),
+        "guard_speed": _POSITIVE,
+        "player_speed": _POSITIVE,
+        "safety_margin": (-math.inf, math.inf, False, False),
+        "safety_penalty": _NON_NEGATIVE,
+        "r_edge_factor": _POSITIVE,
+        "tie_eps": _NON_NEGATIVE,
+    }
+
+
+__all__ = ["PFParams", "FSMParams", "StalenessParams", "PlayerParams"]

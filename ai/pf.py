@@ -1,0 +1,167 @@
+"""Potential-field guards (mode ``pf``): the paper's method (SPEC §3).
+
+The whole team shares one :class:`~ai.fields.CompositeField`. ``tick`` advances it once per
+AI tick; ``decide`` takes the argmin of the kernel-smoothed potential over the guard's
+candidate set; ``explain`` says why, in plain JSON-able types.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from navmesh.graph import NodeGraph
+
+from .fields import Choice, CompositeField, active_guard_nodes, sighting_node
+from .params import PFParams
+from .view import GuardAI, WorldView
+
+
+@dataclass(frozen=True)
+class _Decision:
+    """A decision and references to the (immutable) field arrays it was taken on."""
+
+    t: float
+    node: int
+    choice: Choice
+    information: np.ndarray
+    extra: np.ndarray
+    confidence: np.ndarray
+    potential: np.ndarray
+    kernel: np.ndarray
+    weights: tuple[float, float, float]
+    teammates: np.ndarray
+
+
+class PotentialFieldGuards(GuardAI):
+    """Guards that descend the team's shared composite potential field (paper §Methods).
+
+    >>> import numpy as np
+    >>> from navmesh.graph import NodeGraph
+    >>> from ai.view import WorldView
+    >>> graph = NodeGraph.from_grid(np.ones((1, 5), bool), 1.0)
+    >>> guards = PotentialFieldGuards()
+    >>> guards.reset(graph, np.random.default_rng(0), 1)
+    >>> view = WorldView(t=0.0, graph=graph, guard_nodes=np.array([2]),
+    ...                  guard_positions=graph.positions[[2]], guard_headings=np.zeros(1),
+    ...                  player_node=4, player_pos=graph.positions[4], sighting=4)
+    >>> guards.tick(view, 1.0)
+    >>> guards.decide(0, view), guards.explain(0)["winner"]
+    (3, 3)
+    """
+
+    mode = "pf"
+
+    def __init__(self, params: Mapping[str, Any] | None = None) -> None:
+        super().__init__(params)
+        self.config = PFParams.from_mapping(self.params)
+
+    def reset(self, graph: NodeGraph, rng: np.random.Generator, n_guards: int) -> None:
+        """A fresh field on ``graph``; the graph's matrices are reused from the cache."""
+        self.graph, self.rng, self.n_guards = graph, rng, n_guards
+        self.field = CompositeField(graph, self.config)
+        self._last: list[_Decision | None] = [None] * n_guards
+
+    def tick(self, view: WorldView, dt: float) -> None:
+        """Decay and refresh I and C, adapt the weights (eqs. 1–3, 8)."""
+        self.field.tick(dt, active_guard_nodes(view), sighting_node(view))
+
+    def decide(self, i: int, view: WorldView) -> int:
+        """argmin K over guard ``i``'s candidates (eq. 7).
+
+        Before the trial's first AI tick the field is ticked once with ``dt = 0`` from this
+        view, so the first decisions already see the guards' own confidence deposits.
+        """
+        field = self.field
+        if field.ticks == 0:
+            field.tick(0.0, active_guard_nodes(view), sighting_node(view))
+        node = int(view.guard_nodes[i])
+        teammates = _teammate_nodes(view, i)
+        choice = field.select(node, self.rng, teammates)
+        self._last[i] = _Decision(
+            t=float(view.t),
+            node=node,
+            choice=choice,
+            information=field.information,
+            extra=field.extra_information,
+            confidence=field.confidence,
+            potential=field.potential(),
+            kernel=field.kernel(),
+            weights=field.weights,
+            teammates=teammates,
+        )
+        return choice.winner
+
+    # ------------------------------------------------------------------ stimuli hook
+    @property
+    def extra_information(self) -> np.ndarray:
+        """The field's I_extra layer (see :attr:`CompositeField.extra_information`)."""
+        return self.field.extra_information
+
+    @extra_information.setter
+    def extra_information(self, values: np.ndarray) -> None:
+        self.field.extra_information = values
+
+    # ------------------------------------------------------------------ explainability
+    def explain(self, i: int) -> dict[str, Any] | None:
+        """Guard ``i``'s last decision: candidates with I, I_extra, C, C_live, N, P, K, winner.
+
+        Plain Python types only (JSON-able); None before the guard's first decision. For
+        every candidate ``P = w_I·(I + I_extra) + w_C·(C + C_live) + w_N·N`` (C_live: the
+        teammates' presence at their current nodes), ``K`` is the kernel average of that P
+        over the candidate's hop ball, and the winner has the least K.
+        """
+        record = self._last[i] if 0 <= i < len(self._last) else None
+        if record is None:
+            return None
+        w_I, w_C, w_N = record.weights  # noqa: N806 — the paper's symbols
+        connectivity = self.field.connectivity
+        live = self.field.teammate_confidence(record.teammates)
+        candidates = [
+            {
+                "node": int(c),
+                "I": float(record.information[c]),
+                "I_extra": float(record.extra[c]),
+                "C": float(record.confidence[c]),
+                "C_live": float(live[c]),
+                "N": float(connectivity[c]),
+                "P": float(record.potential[c] + w_C * live[c]),
+                "K": float(k),
+            }
+            for c, k in zip(record.choice.candidates, record.choice.scores, strict=True)
+        ]
+        return {
+            "mode": self.mode,
+            "guard": int(i),
+            "t": record.t,
+            "node": record.node,
+            "teammates": [int(g) for g in record.teammates],
+            "weights": {"w_I": w_I, "w_C": w_C, "w_N": w_N},
+            "candidates": candidates,
+            "winner": record.choice.winner,
+            "tied": [int(c) for c in record.choice.tied],
+            "tie_broken": bool(len(record.choice.tied) > 1),
+        }
+
+    def fields(self) -> dict[str, np.ndarray]:
+        """Current I, I_extra, C, N, P, K arrays (read-only), for the game overlay."""
+        return self.field.fields()
+
+    def state_name(self, i: int) -> str:
+        """``alert`` while a recent detection keeps w_I above its base, else ``patrol``."""
+        return "alert" if self.field.w_I > self.config.w_I_base + 1e-12 else "patrol"
+
+
+def _teammate_nodes(view: WorldView, i: int) -> np.ndarray:
+    """Current nodes of the active guards other than ``i``."""
+    others = np.ones(len(view.guard_nodes), dtype=bool)
+    others[i] = False
+    if view.guard_active is not None:
+        others &= np.asarray(view.guard_active, dtype=bool)
+    return np.asarray(view.guard_nodes, dtype=np.intp)[others]
+
+
+__all__ = ["PotentialFieldGuards"]
