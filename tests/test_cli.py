@@ -1,0 +1,91 @@
+"""The `stealth` command line: JSON shapes of SPEC §9 and one-line errors with exit code 2."""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+
+import pytest
+
+from headless.cli import main
+
+TABLE1 = {  # paper Table 1: rows, cols, walkable, blocked
+    "arkham": (28, 26, 548, 180),
+    "dishonored": (26, 39, 726, 288),
+    "miami": (26, 21, 377, 169),
+    "maze": (20, 20, 206, 194),
+    "tlou": (14, 30, 255, 165),
+}
+
+
+def run_cli(*args: str) -> subprocess.CompletedProcess[str]:
+    return subprocess.run([sys.executable, "-m", "headless.cli", *args],
+                          capture_output=True, text=True, timeout=120)
+
+
+def test_levels_json_reports_table1(capsys: pytest.CaptureFixture) -> None:
+    assert main(["levels", "--json"]) == 0
+    rows = json.loads(capsys.readouterr().out)
+    assert {r["name"] for r in rows} == set(TABLE1)
+    for r in rows:
+        assert set(r) == {"name", "triangles", "min_area", "max_area", "avg_area",
+                          "rows", "cols", "walkable", "blocked"}
+        assert (r["rows"], r["cols"], r["walkable"], r["blocked"]) == TABLE1[r["name"]]
+        assert r["triangles"] > 0 and 0 < r["min_area"] <= r["avg_area"] <= r["max_area"]
+
+
+def test_path_json_shape(capsys: pytest.CaptureFixture) -> None:
+    assert main(["path", "maze", "--from", "1.5,1.5", "--to", "18.5,18.5", "--json"]) == 0
+    document = json.loads(capsys.readouterr().out)
+    assert set(document) == {"points", "length"}
+    assert document["points"][0] == [1.5, 1.5] and document["points"][-1] == [18.5, 18.5]
+    assert document["length"] >= (17**2 + 17**2) ** 0.5
+
+
+@pytest.mark.parametrize(
+    ("args", "needle"),
+    [
+        (["path", "maze", "--from", "0.5,0.5", "--to", "18.5,18.5"], "outside the walkable area"),
+        (["sim", "maze", "--guards", "sniper"], "invalid choice"),
+        (["sim", "maze", "--set", "world.viewrange=3"], "world.viewrange"),
+        (["sim", "no-such-level"], "no-such-level"),
+        (["sim", "maze", "--trace", "/no/such/dir/trace.jsonl"], "--trace"),
+        (["validate", "no-such-level.json"], "no-such-level.json"),
+        (["path", "maze", "--from", "1.5", "--to", "2,2"], "X,Y"),
+    ],
+)
+def test_user_errors_are_one_line_with_exit_code_2(args: list[str], needle: str) -> None:
+    result = run_cli(*args)
+    assert result.returncode == 2, result.stderr
+    assert "Traceback" not in result.stderr
+    lines = [line for line in result.stderr.splitlines() if line.strip()]
+    assert needle in lines[-1]
+    assert result.stdout == ""
+
+
+def test_broken_level_file(tmp_path) -> None:
+    bad = tmp_path / "broken.json"
+    bad.write_text('{"format": "stealth-level/1", "name": "b", "grid": ["..", "."], "guards": [[0.5, 0.5]]}')
+    result = run_cli("sim", str(bad))
+    assert result.returncode == 2 and "Traceback" not in result.stderr
+    assert "broken.json" in result.stderr and "grid" in result.stderr
+
+
+def test_sim_json_is_the_only_stdout_and_trace_lines(tmp_path) -> None:
+    trace = tmp_path / "trace.jsonl"
+    result = run_cli("sim", "tlou", "--guards", "pf", "--player", "maxmin", "--json",
+                     "--trace", str(trace), "--explain", "--set", "world.duration=5")
+    assert result.returncode == 0, result.stderr
+    document = json.loads(result.stdout)
+    assert set(document) >= {"level", "abstraction", "guards", "player", "scenario", "seed",
+                             "metrics"}
+    lines = [json.loads(line) for line in trace.read_text().splitlines()]
+    assert [line["t"] for line in lines] == [0.0, 1.0, 2.0, 3.0, 4.0, 5.0]
+    for line in lines:
+        assert set(line["player"]) >= {"pos", "hp"}
+        assert len(line["guards"]) == 3
+        assert all(set(g) >= {"pos", "heading", "sees_player"} for g in line["guards"])
+        assert isinstance(line["events"], list)
+    explained = [line["explain"] for line in lines[1:] if line.get("explain")]
+    assert explained, "PF decisions are explained in the trace"
