@@ -179,6 +179,8 @@ class World:
             self._enter_node(guard, guard.node, count_visit=True)
             guard.history.append(guard.node)
         self.attackers = 0
+        self._dist_key: tuple[int, ...] = ()
+        self._dist_now: float | None = None
         self._sense()
 
     # ------------------------------------------------------------------ construction
@@ -462,10 +464,16 @@ class World:
                 self.m.first_detect_time = self.t
 
         self.attackers = sum(1 for g in self.guards if g.active and self._in_attack_range(g))
-        active = [g.node for g in self.guards if g.active]
-        if active and self.step_index > 0:
-            self.m.dist_sum += float(self.graph.dist[active, self.player.node].min())
-            self.m.dist_samples += 1
+        if self.step_index > 0:
+            nodes = (self.player.node, *(g.node for g in self.guards if g.active))
+            if nodes != self._dist_key:  # nodes change a few times a second, steps 20 times
+                self._dist_key = nodes
+                self._dist_now = (
+                    float(self.graph.dist[list(nodes[1:]), nodes[0]].min()) if nodes[1:] else None
+                )
+            if self._dist_now is not None:
+                self.m.dist_sum += self._dist_now
+                self.m.dist_samples += 1
 
     def _in_attack_range(self, guard: Agent) -> bool:
         gx, gy = guard.pos
