@@ -21,11 +21,10 @@ import statistics
 import sys
 import time
 from collections.abc import Callable
-from pathlib import Path
 
 import numpy as np
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+import _paths  # noqa: E402,F401  (project importable, this folder unshadowed)
 
 from ai import make_guard_ai, make_player_policy  # noqa: E402
 from ai.fields import _MATRIX_CACHE  # noqa: E402

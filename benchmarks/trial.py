@@ -19,6 +19,7 @@ import time
 import numpy as np
 import pymunk
 
+import _paths  # noqa: F401  (project importable, this folder unshadowed)
 from game.config import Config
 from game.trial import TrialSpec, _cached_level, run_trial
 from navmesh.graph import graph_for

@@ -241,6 +241,10 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--overlay", default="none", help="initial field overlay")
     p.add_argument("--seed", type=int, default=0)
     p.add_argument("--set", action="append", default=[], metavar="KEY=VALUE")
+    p.add_argument("--scenario", choices=["capture", "fixed"], default="capture",
+                   help="capture: game over at HP 0 (default); fixed: respawn, play 60 s")
+    p.add_argument("--mesh", action="store_true", help="start with the grid / navmesh shown")
+    p.add_argument("--plans", action="store_true", help="start with the guards' plans shown")
     p.set_defaults(func=_optional_command("game.front.play", "cmd_play"))
 
     p = sub.add_parser("replay", help="replay a trace written by stealth sim --trace")
@@ -248,6 +252,13 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--level", default=None, help="level of the trace (default: from the trace)")
     p.add_argument("--frames", type=int, default=None)
     p.add_argument("--screenshot", default=None)
+    p.add_argument("--abstraction", choices=["grid", "partition"], default=None,
+                   help="graph the trace's node numbers refer to (default: detected)")
+    p.add_argument("--scenario", choices=["capture", "fixed"], default="capture",
+                   help="scenario of the trace (sets the guards' view range drawn)")
+    p.add_argument("--speed", type=float, default=1.0, help="playback speed (default 1)")
+    p.add_argument("--mesh", action="store_true", help="start with the grid / navmesh shown")
+    p.add_argument("--plans", action="store_true", help="start with the guards' targets shown")
     p.set_defaults(func=_optional_command("game.front.replay", "cmd_replay"))
     return parser
 
@@ -266,4 +277,8 @@ def main(argv: Sequence[str] | None = None) -> int:
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    # Run through the package module so `python -m headless.cli` and the installed script
+    # share one UserError class (other modules import it from headless.cli).
+    from headless.cli import main as _main
+
+    sys.exit(_main())

@@ -1,0 +1,14 @@
+"""Import first in every benchmark script: makes the project importable, unshadowed.
+
+Run as ``python benchmarks/NAME.py``, this folder is ``sys.path[0]`` and a script named
+like a package (``ai.py``) would shadow it; this swaps the folder for the project root.
+"""
+
+import sys
+from pathlib import Path
+
+HERE = Path(__file__).resolve().parent
+ROOT = HERE.parent
+sys.path[:] = [p for p in sys.path if Path(p or ".").resolve() != HERE]
+if str(ROOT) not in sys.path:
+    sys.path.insert(0, str(ROOT))

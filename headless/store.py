@@ -1,0 +1,245 @@
+"""The results store of a sweep: one SQLite file, one row per finished trial.
+
+``DIR/results.sqlite`` (stdlib :mod:`sqlite3`, WAL journal) holds
+
+* ``trials`` — one row per trial, keyed by :attr:`game.trial.TrialSpec.key`: the trial's
+  identity, seed, config hash, one column per metric, the per-node ``visits`` and
+  ``attacks`` lists (zlib-compressed JSON, ``json.loads(zlib.decompress(blob))``), the error
+  text (``NULL`` on success), the wall time and when it finished;
+* ``meta`` — key/value text: the preset (its TOML text and its expanded design as JSON) and
+  the config hash, so ``stealth report`` knows the design and a resumed sweep can check
+  that it continues the same experiment.
+
+Every finished trial is committed at once, so a sweep killed at any moment loses at most
+the trials still running. Only the sweep's main process writes; readers (``stealth
+report``, a notebook) may read while it runs.
+
+>>> import tempfile, pathlib
+>>> with ResultStore(pathlib.Path(tempfile.mkdtemp()) / "results.sqlite") as store:
+...     store.count()
+(0, 0)
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import sqlite3
+import zlib
+from collections.abc import Iterator, Mapping
+from datetime import datetime, timezone
+from pathlib import Path
+from types import TracebackType
+from typing import Any
+
+__all__ = ["IDENTITY", "METRICS", "METRIC_NAMES", "STORE_NAME", "ResultStore", "StoredTrial", "pack",
+           "unpack"]
+
+STORE_NAME = "results.sqlite"
+"""File name of the store inside a results directory."""
+
+IDENTITY: tuple[str, ...] = ("level", "abstraction", "guards", "player", "scenario", "seed",
+                             "root_seed")
+"""Identity columns of a trial (with ``config_hash`` they say exactly what ran)."""
+
+METRICS: tuple[tuple[str, str], ...] = (
+    ("captured", "INTEGER"),
+    ("capture_time", "REAL"),
+    ("captures", "INTEGER"),
+    ("coverage", "REAL"),
+    ("avg_guard_player_dist", "REAL"),
+    ("first_detect_time", "REAL"),
+    ("backtracks", "INTEGER"),
+)
+"""Metric columns (SPEC §7/§9); any other metric a trial reports goes to ``extra_metrics``."""
+
+METRIC_NAMES: tuple[str, ...] = tuple(name for name, _ in METRICS)
+
+_SCHEMA = f"""
+CREATE TABLE IF NOT EXISTS trials (
+    key TEXT PRIMARY KEY,
+    level TEXT NOT NULL,
+    level_ref TEXT NOT NULL,
+    abstraction TEXT NOT NULL,
+    guards TEXT NOT NULL,
+    player TEXT NOT NULL,
+    scenario TEXT NOT NULL,
+    seed INTEGER NOT NULL,
+    root_seed INTEGER NOT NULL,
+    overrides TEXT NOT NULL,
+    config_hash TEXT,
+    {", ".join(f"{name} {kind}" for name, kind in METRICS)},
+    extra_metrics TEXT,
+    visits BLOB,
+    attacks BLOB,
+    error TEXT,
+    wall_time REAL,
+    finished_at TEXT NOT NULL
+);
+CREATE TABLE IF NOT EXISTS meta (
+    key TEXT PRIMARY KEY,
+    value TEXT NOT NULL
+);
+"""
+
+_COLUMNS: tuple[str, ...] = (
+    "key", "level", "level_ref", "abstraction", "guards", "player", "scenario", "seed",
+    "root_seed", "overrides", "config_hash", *METRIC_NAMES, "extra_metrics", "visits",
+    "attacks", "error", "wall_time", "finished_at",
+)
+
+# A key is written once: a success is never overwritten, a failure is replaced by a later
+# attempt (a rerun retries failed trials), and the key is never duplicated.
+_UPSERT = (
+    f"INSERT INTO trials ({', '.join(_COLUMNS)}) VALUES ({', '.join('?' * len(_COLUMNS))}) "
+    f"ON CONFLICT(key) DO UPDATE SET "
+    + ", ".join(f"{c} = excluded.{c}" for c in _COLUMNS if c != "key")
+    + " WHERE trials.error IS NOT NULL"
+)
+
+
+def pack(values: list[Any] | None) -> bytes | None:
+    """A list of numbers as zlib-compressed JSON (how ``visits`` and ``attacks`` are stored)."""
+    if values is None:
+        return None
+    return zlib.compress(json.dumps(values, separators=(",", ":")).encode(), 6)
+
+
+def unpack(blob: bytes | None) -> list[Any] | None:
+    """The inverse of :func:`pack`."""
+    if blob is None:
+        return None
+    return json.loads(zlib.decompress(blob))
+
+
+def _now() -> str:
+    return datetime.now(timezone.utc).isoformat(timespec="milliseconds")
+
+
+def _metric_value(value: Any) -> Any:
+    if isinstance(value, bool):
+        return int(value)
+    if isinstance(value, float) and not math.isfinite(value):
+        return None
+    return value
+
+
+class StoredTrial(dict[str, Any]):
+    """One ``trials`` row as a dict; ``visits``/``attacks`` already decoded to lists."""
+
+
+class ResultStore:
+    """The SQLite results store of one results directory (see the module docstring).
+
+    Open it with ``ResultStore(path)``; ``readonly=True`` never creates or changes the file.
+    """
+
+    def __init__(self, path: str | Path, *, readonly: bool = False) -> None:
+        self.path = Path(path)
+        if readonly:
+            uri = f"{self.path.resolve().as_uri()}?mode=ro"
+            self.db = sqlite3.connect(uri, uri=True, timeout=30.0)
+        else:
+            self.db = sqlite3.connect(self.path, timeout=30.0)
+            self.db.execute("PRAGMA journal_mode=WAL")
+            self.db.execute("PRAGMA synchronous=NORMAL")  # WAL: durable against a killed process
+            self.db.executescript(_SCHEMA)
+            self.db.commit()
+        self.db.row_factory = sqlite3.Row
+
+    # ------------------------------------------------------------------ context manager
+    def __enter__(self) -> ResultStore:
+        return self
+
+    def __exit__(
+        self,
+        kind: type[BaseException] | None,
+        error: BaseException | None,
+        tb: TracebackType | None,
+    ) -> None:
+        self.close()
+
+    def close(self) -> None:
+        """Close the connection (everything written is already committed)."""
+        self.db.close()
+
+    # ------------------------------------------------------------------ meta
+    def get_meta(self, key: str) -> str | None:
+        """A ``meta`` value, or None."""
+        row = self.db.execute("SELECT value FROM meta WHERE key = ?", (key,)).fetchone()
+        return None if row is None else str(row[0])
+
+    def set_meta(self, values: Mapping[str, str]) -> None:
+        """Write ``meta`` values (replacing old ones) and commit."""
+        with self.db:
+            self.db.executemany(
+                "INSERT OR REPLACE INTO meta (key, value) VALUES (?, ?)", list(values.items())
+            )
+
+    def meta(self) -> dict[str, str]:
+        """Every ``meta`` value."""
+        return {r[0]: r[1] for r in self.db.execute("SELECT key, value FROM meta")}
+
+    # ------------------------------------------------------------------ trials
+    def done_keys(self) -> set[str]:
+        """Keys of the trials that finished without error (a rerun skips these)."""
+        return {r[0] for r in self.db.execute("SELECT key FROM trials WHERE error IS NULL")}
+
+    def count(self) -> tuple[int, int]:
+        """``(finished, failed)`` trial counts."""
+        row = self.db.execute(
+            "SELECT COUNT(*) - COUNT(error), COUNT(error) FROM trials"
+        ).fetchone()
+        return int(row[0]), int(row[1])
+
+    def add(self, row: Mapping[str, Any]) -> None:
+        """Record one trial row (from :func:`game.trial.run_trial`, or a failure) and commit.
+
+        ``row`` needs the identity fields, ``key`` and ``level_ref``; a failed trial has
+        ``error`` (text) and no metrics. An existing successful row with the same key is
+        kept as it is.
+        """
+        metrics = dict(row.get("metrics") or {})
+        extra = {k: v for k, v in metrics.items() if k not in METRIC_NAMES}
+        values = {
+            "key": row["key"],
+            "level": row["level"],
+            "level_ref": row["level_ref"],
+            "abstraction": row["abstraction"],
+            "guards": row["guards"],
+            "player": row["player"],
+            "scenario": row["scenario"],
+            "seed": int(row["seed"]),
+            "root_seed": int(row.get("root_seed", 0)),
+            "overrides": json.dumps(dict(row.get("overrides") or {}), sort_keys=True),
+            "config_hash": row.get("config_hash"),
+            **{name: _metric_value(metrics.get(name)) for name in METRIC_NAMES},
+            "extra_metrics": json.dumps(extra, sort_keys=True) if extra else None,
+            "visits": pack(row.get("visits")),
+            "attacks": pack(row.get("attacks")),
+            "error": row.get("error"),
+            "wall_time": row.get("wall_time"),
+            "finished_at": _now(),
+        }
+        with self.db:
+            self.db.execute(_UPSERT, [values[c] for c in _COLUMNS])
+
+    def trials(self, *, failed: bool = False, heatmaps: bool = False) -> Iterator[StoredTrial]:
+        """Finished trials (or, with ``failed=True``, the failed ones) in identity order.
+
+        ``visits``/``attacks`` are decoded only with ``heatmaps=True``.
+        """
+        where = "error IS NOT NULL" if failed else "error IS NULL"
+        columns = [c for c in _COLUMNS if heatmaps or c not in ("visits", "attacks")]
+        order = ", ".join(IDENTITY)
+        query = f"SELECT {', '.join(columns)} FROM trials WHERE {where} ORDER BY {order}"
+        for r in self.db.execute(query):
+            trial = StoredTrial(zip(columns, tuple(r)))
+            if trial.get("captured") is not None:
+                trial["captured"] = bool(trial["captured"])
+            trial["overrides"] = json.loads(trial["overrides"])
+            trial["extra_metrics"] = json.loads(trial["extra_metrics"] or "{}")
+            if heatmaps:
+                trial["visits"] = unpack(trial["visits"])
+                trial["attacks"] = unpack(trial["attacks"])
+            yield trial
