@@ -19,19 +19,14 @@ from __future__ import annotations
 import argparse
 import os
 import statistics
-import sys
-from pathlib import Path
 
-# Run as a script, this folder comes first on sys.path, and benchmarks/ai.py would shadow
-# the ``ai`` package: look the packages up from the repository root instead.
-_HERE = Path(__file__).resolve().parent
-sys.path[:] = [p for p in sys.path if Path(p or ".").resolve() != _HERE]
-sys.path.insert(0, str(_HERE.parent))
+import _paths  # noqa: E402,F401  (project importable, this folder unshadowed)
+
 os.environ.setdefault("SDL_VIDEODRIVER", "dummy")
 os.environ.setdefault("PYGAME_HIDE_SUPPORT_PROMPT", "1")
 
-from game.front.play import PlayGame, PlaySettings  # noqa: E402
-from game.scene import OVERLAYS  # noqa: E402
+from game.front.play import PlayGame, PlaySettings
+from game.scene import OVERLAYS
 
 MEDIAN_TARGET_MS = 8.0
 P99_TARGET_MS = 16.7

@@ -26,8 +26,9 @@ def _user_errors() -> tuple[type[BaseException], ...]:
     from game.config import ConfigError
     from navmesh.level import LevelError
     from navmesh.mesh import OutsideError
+    from ai.stimuli import StimulusError
 
-    return (UserError, LevelError, ConfigError, OutsideError)
+    return (UserError, LevelError, ConfigError, OutsideError, StimulusError)
 
 
 def _point(text: str) -> tuple[float, float]:
@@ -138,7 +139,11 @@ def cmd_sim(args: argparse.Namespace) -> int:
     from game.trial import TrialSpec, run_trial, sim_document
     from navmesh.level import load_level
 
+    from ai.stimuli import load_stimulus
+
     load_level(args.level)  # a bad level fails here with its one-line message
+    for plugin in args.stimulus:
+        load_stimulus(plugin)  # a bad plugin fails here with its one-line message
     spec = TrialSpec(
         level=args.level,
         abstraction=args.abstraction,
@@ -147,6 +152,7 @@ def cmd_sim(args: argparse.Namespace) -> int:
         scenario=args.scenario,
         seed=args.seed,
         overrides=_overrides(args.set),
+        stimuli=tuple(args.stimulus),
     )
     if args.trace:
         try:
@@ -218,7 +224,18 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--explain", action="store_true",
                    help="add the first guard's decision explained to each trace line "
                         "(to stderr when no --trace)")
+    p.add_argument("--stimulus", action="append", default=[], metavar="FILE.py:NAME",
+                   help="add a stimulus (a Stimulus subclass or factory in FILE.py, or an "
+                        "installed stealthfield.stimuli entry point); repeatable")
     p.set_defaults(func=cmd_sim)
+
+    p = sub.add_parser("mechanics", help="measured effects of the stealth mechanics (docs/mechanics.md)")
+    p.add_argument("--seeds", type=int, default=30, help="paired seeds per mechanic (default 30)")
+    p.add_argument("--out", default="results/mechanics", help="directory for mechanics.md and .csv")
+    p.add_argument("--workers", type=int, default=None, help="worker processes (1 = in-process)")
+    p.add_argument("--level", default="miami", help="level (default miami)")
+    p.add_argument("--abstraction", choices=["grid", "partition"], default="grid")
+    p.set_defaults(func=_optional_command("headless.mechanics", "cmd_mechanics"))
 
     p = sub.add_parser("run", help="run a sweep (resumable, parallel)")
     p.add_argument("--preset", default="smoke", help="preset name or TOML file")

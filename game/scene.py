@@ -1,0 +1,481 @@
+"""What there is to draw: a renderer-independent picture of a world (SPEC §1, STYLE).
+
+The simulation core never imports pygame. This module turns a :class:`~game.world.World`
+(or a replayed trace) into plain data — numpy arrays, tuples and strings — that any
+front end can draw: the pygame adapter in :mod:`game.front.render` is one, a PNG exporter
+with matplotlib could be another.
+
+* :class:`StaticScene` — what never moves: floor rings, walls, zones (clipped to the
+  walkable area), static decoys, the grid cells or the navmesh triangles, node positions.
+* :class:`Scene` — one frame: guards (with their vision cones clipped by walls, their
+  plans), the player, HP, detection state and an optional :class:`FieldLayer`.
+* :func:`vision_cone` — the exact visible part of a guard's view sector: rays cast
+  against the wall segments with numpy, including rays grazing every wall corner, so the
+  polygon ends exactly where the walls block the guard's line of sight (the same segment
+  test :meth:`World.sees` does with pymunk).
+
+>>> from navmesh.level import parse_level
+>>> from navmesh.graph import build_graph
+>>> level = parse_level({"format": "stealth-level/1", "name": "box",
+...                      "grid": ["#####", "#...#", "#####"], "guards": [[1.5, 1.5]]})
+>>> builder = SceneBuilder(level, build_graph(level, "grid"), view_range=8.0, fov_deg=90.0)
+>>> cone = builder.cone((1.5, 1.5), 0.0, 8.0)
+>>> float(cone[:, 0].max())  # the ray straight ahead stops at the wall x = 4
+4.0
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+import shapely
+from shapely.geometry import Polygon
+from shapely.geometry.base import BaseGeometry
+
+from navmesh.graph import NodeGraph
+from navmesh.level import Level
+
+if TYPE_CHECKING:
+    from .world import World
+
+Point = tuple[float, float]
+
+#: Overlay keys in the order the overlay key cycles through them.
+OVERLAYS: tuple[str, ...] = ("none", "I", "C", "N", "P", "K")
+
+#: Human-readable names of the overlays (legend titles).
+OVERLAY_LABELS: dict[str, str] = {
+    "none": "no overlay",
+    "I": "Information I",
+    "C": "Confidence C",
+    "N": "Connectivity N",
+    "P": "Composite potential P",
+    "K": "Kernel K",
+}
+
+#: Accepted spellings of overlay names on the command line.
+OVERLAY_ALIASES: dict[str, str] = {
+    "none": "none", "off": "none",
+    "i": "I", "information": "I", "info": "I",
+    "c": "C", "confidence": "C",
+    "n": "N", "connectivity": "N",
+    "p": "P", "potential": "P", "composite": "P",
+    "k": "K", "kernel": "K",
+}
+
+#: Rays per radian of field of view (about one every 1.6°), before the corner rays.
+RAYS_PER_RADIAN = 36.0
+#: Angular offset of the two rays cast either side of a wall corner.
+_CORNER_EPS = 1e-4
+
+
+def overlay_key(name: str) -> str:
+    """The overlay key (``none``, ``I``, ``C``, ``N``, ``P``, ``K``) for a name or alias.
+
+    >>> overlay_key("kernel"), overlay_key("I")
+    ('K', 'I')
+    """
+    key = OVERLAY_ALIASES.get(name.strip().lower())
+    if key is None:
+        names = "none, information, confidence, connectivity, potential, kernel"
+        raise ValueError(f"unknown overlay {name!r} (choose from {names}, or I C N P K)")
+    return key
+
+
+# ---------------------------------------------------------------------------- static part
+
+
+@dataclass(frozen=True, eq=False)
+class StaticScene:
+    """The parts of a level that never move, in world units (x right, y down)."""
+
+    name: str
+    #: world extent drawn: x in [0, width], y in [0, height]
+    width: float
+    height: float
+    cell_size: float
+    #: walkable area as rings: ``floor[0]`` the outline, the rest holes (obstacles)
+    floor: tuple[np.ndarray, ...]
+    #: wall segments ``(m, 2, 2)``
+    walls: np.ndarray
+    #: per zone kind, polygons clipped to the walkable area, each as (exterior, *holes) rings
+    zones: Mapping[str, tuple[tuple[np.ndarray, ...], ...]]
+    #: static decoy points ``(k, 2)``
+    decoys: np.ndarray
+    #: ``"grid"`` or ``"partition"``
+    kind: str
+    #: node positions ``(n, 2)``
+    nodes: np.ndarray
+    #: grid: walkable mask ``(rows, cols)``
+    occupancy: np.ndarray
+    #: grid: node index per cell ``(rows, cols)``, -1 blocked; None on a partition
+    cell_node: np.ndarray | None
+    #: partition: triangle corners ``(T, 3, 2)`` (node t is triangle t); None on a grid
+    triangles: np.ndarray | None
+
+    @classmethod
+    def from_level(cls, level: Level, graph: NodeGraph) -> StaticScene:
+        """Collect what is drawn of ``level`` in the abstraction of ``graph``."""
+        _, _, maxx, maxy = level.walkable.bounds
+        width = max(maxx, level.cols * level.cell_size)
+        height = max(maxy, level.rows * level.cell_size)
+        floor = _rings(level.walkable)[0]
+        zones = {}
+        for kind, polygons in level.zones.items():
+            clipped = [level.walkable.intersection(p) for p in polygons]
+            zones[kind] = tuple(r for g in clipped for r in _rings(g))
+        triangles = None
+        if graph.mesh is not None:
+            triangles = np.asarray(graph.mesh.vertices)[np.asarray(graph.mesh.triangles)]
+        decoys = np.asarray(level.decoys, dtype=np.float64).reshape(-1, 2)
+        return cls(
+            name=level.name, width=float(width), height=float(height),
+            cell_size=float(level.cell_size), floor=floor,
+            walls=np.asarray(level.walls, dtype=np.float64), zones=zones, decoys=decoys,
+            kind=graph.kind, nodes=np.asarray(graph.positions, dtype=np.float64),
+            occupancy=np.asarray(level.occupancy, dtype=bool),
+            cell_node=None if graph.cell_node is None else np.asarray(graph.cell_node),
+            triangles=triangles,
+        )
+
+
+def _rings(geometry: BaseGeometry) -> list[tuple[np.ndarray, ...]]:
+    """Every polygon of ``geometry`` as (exterior, *holes) coordinate arrays (no closing point)."""
+    polygons = [g for g in shapely.get_parts(geometry) if isinstance(g, Polygon) and not g.is_empty]
+    out = []
+    for polygon in polygons:
+        rings = [np.asarray(polygon.exterior.coords, dtype=np.float64)[:-1, :2]]
+        rings += [np.asarray(r.coords, dtype=np.float64)[:-1, :2] for r in polygon.interiors]
+        out.append(tuple(rings))
+    return out
+
+
+# ---------------------------------------------------------------------------- dynamic part
+
+
+@dataclass(frozen=True, eq=False)
+class GuardDrawing:
+    """One guard as drawn: body, cone, behaviour label and (optionally) its plan."""
+
+    pos: Point
+    heading: float
+    active: bool
+    sees_player: bool
+    state: str
+    #: visible part of the view sector, ``(k, 2)``, apex first; empty when inactive
+    cone: np.ndarray
+    #: position of the target node (None unless plans are requested)
+    target: Point | None = None
+    #: remaining waypoints ``(k, 2)`` (empty unless plans are requested)
+    path: np.ndarray = field(default_factory=lambda: np.zeros((0, 2)))
+    #: candidate node positions of the last decision ``(c, 2)`` (PF only, with plans)
+    candidates: np.ndarray = field(default_factory=lambda: np.zeros((0, 2)))
+    #: position of the chosen candidate (PF only, with plans)
+    chosen: Point | None = None
+
+
+@dataclass(frozen=True)
+class PlayerDrawing:
+    """The player as drawn."""
+
+    pos: Point
+    heading: float
+    hp: float
+    hp_max: float
+    sprinting: bool = False
+    concealed: bool = False
+
+
+@dataclass(frozen=True, eq=False)
+class FieldLayer:
+    """A per-node field ready for a colour map.
+
+    ``norm = values / max|values|`` lies in [-1, 1] (0 where the field is 0): negative
+    values attract the guards (they move to the least K), positive ones repel them.
+    """
+
+    key: str
+    label: str
+    values: np.ndarray
+    vmin: float
+    vmax: float
+    norm: np.ndarray
+
+    @classmethod
+    def from_values(cls, key: str, values: np.ndarray, label: str | None = None) -> FieldLayer:
+        """Normalise ``values`` symmetrically around 0."""
+        values = np.asarray(values, dtype=np.float64)
+        vmin = float(values.min()) if len(values) else 0.0
+        vmax = float(values.max()) if len(values) else 0.0
+        scale = max(abs(vmin), abs(vmax))
+        norm = values / scale if scale > 1e-12 else np.zeros_like(values)
+        return cls(key, label or OVERLAY_LABELS.get(key, key), values, vmin, vmax, norm)
+
+
+@dataclass(frozen=True, eq=False)
+class Scene:
+    """One frame of the game: everything a front end needs to draw it."""
+
+    static: StaticScene
+    t: float
+    duration: float
+    guards: tuple[GuardDrawing, ...]
+    player: PlayerDrawing
+    seen_by: tuple[int, ...] = ()
+    attackers: int = 0
+    #: ``"playing"``, ``"captured"`` or ``"survived"``
+    status: str = "playing"
+    mode: str = ""
+    abstraction: str = ""
+    #: the requested overlay key (``"none"`` for none)
+    overlay: str = "none"
+    #: the field of the requested overlay; None when off or when the mode has no fields
+    layer: FieldLayer | None = None
+    #: why ``layer`` is None although an overlay is requested (e.g. mode without fields)
+    field_note: str = ""
+    #: guard reach now (shorter while the player stands in concealment)
+    reach: float = 0.0
+    attack_range: float = 0.0
+    agent_radius: float = 0.3
+    #: dynamic decoys or other stimulus markers ``(k, 2)`` (thrown decoys, corpses, ...)
+    markers: np.ndarray = field(default_factory=lambda: np.zeros((0, 2)))
+    rain: bool | None = None
+    events: tuple[str, ...] = ()
+    captures: int = 0
+
+    @property
+    def detected(self) -> bool:
+        """Whether any guard sees the player in this frame."""
+        return bool(self.seen_by)
+
+
+# ---------------------------------------------------------------------------- building
+
+
+class SceneBuilder:
+    """Builds :class:`Scene` frames for one level and abstraction (static part cached).
+
+    Field layers are cached by the identity of the source arrays (the AI hands out
+    immutable snapshots that change once per AI tick), so a renderer can cache its
+    colour-mapped image by the identity of the layer.
+    """
+
+    def __init__(
+        self, level: Level, graph: NodeGraph, *, view_range: float, fov_deg: float,
+        rays_per_radian: float = RAYS_PER_RADIAN,
+    ) -> None:
+        self.level, self.graph = level, graph
+        self.static = StaticScene.from_level(level, graph)
+        self.view_range = float(view_range)
+        self.half_fov = math.radians(float(fov_deg)) / 2.0
+        self.rays = max(3, math.ceil(2.0 * self.half_fov * rays_per_radian) + 1)
+        walls = self.static.walls
+        self._a = walls[:, 0].copy()
+        self._d = walls[:, 1] - walls[:, 0]
+        corners = np.unique(walls.reshape(-1, 2), axis=0)
+        self._corners = corners
+        self._layers: dict[str, tuple[tuple[int, ...], tuple[Any, ...], FieldLayer]] = {}
+
+    # ------------------------------------------------------------------ cones
+    def cone(self, pos: Point, heading: float, reach: float) -> np.ndarray:
+        """The visible part of the view sector at ``pos`` facing ``heading``, ``(k, 2)``.
+
+        The first point is the apex; the rest run counter-clockwise in angle (y down: from
+        ``heading - fov/2`` to ``heading + fov/2``).
+        """
+        return vision_cone(self._a, self._d, self._corners, pos, heading, self.half_fov,
+                           reach, self.rays)
+
+    # ------------------------------------------------------------------ fields
+    def field_layer(self, key: str, fields: Mapping[str, np.ndarray]) -> FieldLayer | None:
+        """The layer of overlay ``key`` from a guard AI's ``fields()`` dict (None if absent).
+
+        ``I`` shows the information field plus the stimuli layer (``I + I_extra``), which
+        is what enters P.
+        """
+        if key == "none":
+            return None
+        extra = fields.get("I_extra") if key == "I" else None
+        sources: tuple[Any, Any] = (fields.get(key), extra)
+        if sources[0] is None:
+            return None
+        ids = tuple(id(s) for s in sources)
+        cached = self._layers.get(key)
+        if cached is not None and cached[0] == ids:
+            return cached[2]
+        values = np.asarray(sources[0], dtype=np.float64)
+        label = OVERLAY_LABELS[key]
+        if key == "I" and sources[1] is not None and np.any(np.asarray(sources[1]) != 0):
+            values = values + np.asarray(sources[1], dtype=np.float64)
+            label = "Information I + stimuli"
+        layer = FieldLayer.from_values(key, values, label)
+        self._layers[key] = (ids, sources, layer)  # keep the sources alive: ids stay unique
+        return layer
+
+    # ------------------------------------------------------------------ from a world
+    def from_world(self, world: World, overlay: str = "none", plans: bool = False) -> Scene:
+        """The frame of ``world`` now, with the ``overlay`` field and optionally the plans."""
+        concealed = _concealed(world.zones, world.player.node)
+        reach = world.view_range * _view_scale(world, concealed)
+        seen = set(world.seen_by)
+        positions = self.graph.positions
+        explain = getattr(world.guard_ai, "explain", None)
+        guards = []
+        for i, g in enumerate(world.guards):
+            cone = self.cone(g.pos, g.heading, reach) if g.active else np.zeros((0, 2))
+            extra: dict[str, Any] = {}
+            if plans and g.active:
+                extra["target"] = (float(positions[g.target][0]), float(positions[g.target][1]))
+                extra["path"] = np.asarray(list(g.waypoints), dtype=np.float64).reshape(-1, 2)
+                record = explain(i) if explain is not None else None
+                if record and record.get("candidates"):
+                    nodes = [c["node"] for c in record["candidates"]]
+                    extra["candidates"] = positions[nodes]
+                    won = positions[int(record["winner"])]
+                    extra["chosen"] = (float(won[0]), float(won[1]))
+            guards.append(GuardDrawing(
+                pos=g.pos, heading=g.heading, active=g.active, sees_player=i in seen,
+                state=_state_name(world, i) if g.active else "down", cone=cone, **extra,
+            ))
+        field_layer, note = None, ""
+        if overlay != "none":
+            getter = getattr(world.guard_ai, "fields", None)
+            if getter is None:
+                note = f"no fields in mode {getattr(world.guard_ai, 'mode', '?')}"
+            else:
+                field_layer = self.field_layer(overlay, getter())
+                if field_layer is None:
+                    note = f"field {overlay} not available"
+        if world.done:
+            status = "captured" if (world.end_on_capture and world.m.captures) else "survived"
+        else:
+            status = "playing"
+        return Scene(
+            static=self.static,
+            t=world.t,
+            duration=world.total_steps * world.dt,
+            guards=tuple(guards),
+            player=PlayerDrawing(
+                pos=world.player.pos, heading=world.player.heading, hp=world.hp,
+                hp_max=world.hp_max, sprinting=bool(world.sprinting), concealed=concealed,
+            ),
+            seen_by=tuple(world.seen_by),
+            attackers=int(getattr(world, "attackers", 0)),
+            status=status,
+            mode=str(getattr(world.guard_ai, "mode", "")),
+            abstraction=world.graph.kind,
+            overlay=overlay,
+            layer=field_layer,
+            field_note=note,
+            reach=reach,
+            attack_range=world.attack_range,
+            agent_radius=world.radius,
+            markers=_markers(world),
+            rain=_rain(world),
+            events=tuple(e.kind for e in world.tick_events),
+            captures=world.m.captures,
+        )
+
+
+def _concealed(zones: Mapping[str, np.ndarray], node: int) -> bool:
+    mask = zones.get("concealment")
+    return bool(mask is not None and 0 <= node < len(mask) and mask[node])
+
+
+def _view_scale(world: World, concealed: bool) -> float:
+    """The factor on the guards' view range where the player stands (as World.sees uses)."""
+    per_node = getattr(world, "view_scale_at", None)
+    if per_node is not None:
+        return float(per_node[world.player.node])
+    return float(world.concealment_view_scale) if concealed else 1.0
+
+
+def _state_name(world: World, i: int) -> str:
+    try:
+        return str(world.guard_ai.state_name(i))
+    except (AttributeError, IndexError, TypeError):
+        return ""
+
+
+def _rain(world: World) -> bool | None:
+    """Whether it rains, for worlds that know about weather (None otherwise)."""
+    for name in ("raining", "rain"):
+        value = getattr(world, name, None)
+        if isinstance(value, (bool, np.bool_)):
+            return bool(value)
+    return None
+
+
+def _markers(world: World) -> np.ndarray:
+    """Positions of dynamic stimuli the world exposes (``stimulus_points()``), if any."""
+    getter = getattr(world, "stimulus_points", None)
+    if getter is None:
+        return np.zeros((0, 2))
+    try:
+        return np.asarray(getter(), dtype=np.float64).reshape(-1, 2)
+    except (TypeError, ValueError):
+        return np.zeros((0, 2))
+
+
+# ---------------------------------------------------------------------------- ray casting
+
+
+def vision_cone(
+    wall_start: np.ndarray, wall_delta: np.ndarray, corners: np.ndarray, pos: Sequence[float],
+    heading: float, half_fov: float, reach: float, rays: int,
+) -> np.ndarray:
+    """Visible polygon of a view sector, clipped by wall segments (vectorised ray casting).
+
+    Rays are cast at ``rays`` evenly spaced angles over ``heading ± half_fov`` plus two
+    rays grazing every wall corner inside the sector, so the outline follows the walls'
+    corners exactly. Returns ``(k, 2)``: the apex ``pos`` then the ray end points in
+    increasing angle.
+    """
+    px, py = float(pos[0]), float(pos[1])
+    origin = np.array([px, py])
+    # Walls that can matter: closest point within reach.
+    rel = origin - wall_start
+    dd = np.einsum("ij,ij->i", wall_delta, wall_delta)
+    s = np.clip(np.einsum("ij,ij->i", rel, wall_delta) / np.maximum(dd, 1e-18), 0.0, 1.0)
+    near = np.hypot(*(wall_start + s[:, None] * wall_delta - origin).T) <= reach + 1e-9
+    a, d = wall_start[near], wall_delta[near]
+
+    angles = heading + np.linspace(-half_fov, half_fov, rays)
+    if len(corners):
+        cv = corners - origin
+        cd = np.hypot(cv[:, 0], cv[:, 1])
+        ca = np.arctan2(cv[:, 1], cv[:, 0])
+        off = (ca - heading + math.pi) % (2 * math.pi) - math.pi
+        inside = (cd <= reach) & (cd > 1e-9) & (np.abs(off) < half_fov)
+        if inside.any():
+            base = heading + off[inside]
+            extra = np.concatenate([base - _CORNER_EPS, base + _CORNER_EPS])
+            extra = extra[np.abs(extra - heading) <= half_fov]
+            angles = np.sort(np.concatenate([angles, extra]))
+    ux, uy = np.cos(angles), np.sin(angles)
+    t = np.full(len(angles), float(reach))
+    if len(a):
+        # Solve origin + t·u = a + s·d for every (ray, wall).
+        denom = ux[:, None] * d[None, :, 1] - uy[:, None] * d[None, :, 0]
+        wx, wy = a[:, 0] - px, a[:, 1] - py
+        with np.errstate(divide="ignore", invalid="ignore"):
+            tt = (wx[None, :] * d[None, :, 1] - wy[None, :] * d[None, :, 0]) / denom
+            ss = (wx[None, :] * uy[:, None] - wy[None, :] * ux[:, None]) / denom
+        hit = (np.abs(denom) > 1e-12) & (tt > 1e-9) & (ss >= -1e-9) & (ss <= 1 + 1e-9)
+        tt = np.where(hit, tt, np.inf)
+        t = np.minimum(t, tt.min(axis=1))
+    points = np.empty((len(angles) + 1, 2))
+    points[0] = origin
+    points[1:, 0] = px + t * ux
+    points[1:, 1] = py + t * uy
+    return points
+
+
+__all__ = [
+    "OVERLAYS", "OVERLAY_LABELS", "FieldLayer", "GuardDrawing", "PlayerDrawing", "Scene",
+    "SceneBuilder", "StaticScene", "overlay_key", "vision_cone",
+]
