@@ -200,6 +200,7 @@ class CompositeField:
         self._extra = zeros
         self._confidence_decay = _read_only(np.full(n, self.params.rho))
         self._decay_cache: tuple[float, np.ndarray, np.ndarray] | None = None
+        self._w_I_floor = 0.0
         self._set_w_I(self.params.w_I_base)
         self.ticks = 0
         self._version = 0
@@ -262,6 +263,25 @@ class CompositeField:
         self.confidence_decay = values
 
     @property
+    def information_weight_floor(self) -> float:
+        """A lower bound on w_I asked for by stimuli (0 = none; e.g. an alarm puts guards on alert).
+
+        While it is above w_I, w_I is raised to it at once and eq. 8 never takes w_I below it;
+        when it is lowered, w_I decays from where it is at δ_w per second as after a sighting.
+        """
+        return self._w_I_floor
+
+    @information_weight_floor.setter
+    def information_weight_floor(self, value: float | None) -> None:
+        floor = 0.0 if value is None else float(value)
+        if not 0.0 <= floor <= 1.0:
+            raise ValueError(f"information_weight_floor must be in [0, 1], got {value!r}")
+        self._w_I_floor = floor
+        if self.w_I < floor:
+            self._set_w_I(floor)
+            self._version += 1
+
+    @property
     def weights(self) -> tuple[float, float, float]:
         """(w_I, w_C, w_N), summing to 1."""
         return self.w_I, self.w_C, self.w_N
@@ -291,6 +311,8 @@ class CompositeField:
         else:
             information = self._information * (p.rho**dt)
             self._set_w_I(max(p.w_I_base, self.w_I - p.weight_decay * dt))
+        if self.w_I < self._w_I_floor:
+            self._set_w_I(self._w_I_floor)
         confidence = self._confidence * self._decay_power(dt)
         guards = np.asarray(guard_nodes, dtype=np.intp)
         if len(guards):

@@ -105,6 +105,19 @@ class PotentialFieldGuards(GuardAI):
     def extra_information(self, values: np.ndarray) -> None:
         self.field.extra_information = values
 
+    @property
+    def information_weight_floor(self) -> float:
+        """Lower bound on w_I asked for by stimuli (see :attr:`CompositeField.information_weight_floor`)."""
+        return self.field.information_weight_floor
+
+    @information_weight_floor.setter
+    def information_weight_floor(self, value: float | None) -> None:
+        self.field.information_weight_floor = value
+
+    def set_confidence_decay(self, nodes: np.ndarray, rate: float) -> None:
+        """Zones hook: confidence decay ``rate`` per second in ``nodes`` (indices or a mask)."""
+        self.field.set_confidence_decay(nodes, rate)
+
     # ------------------------------------------------------------------ explainability
     def explain(self, i: int) -> dict[str, Any] | None:
         """Guard ``i``'s last decision: candidates with I, I_extra, C, C_live, N, P, K, winner.

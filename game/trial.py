@@ -19,6 +19,7 @@ from typing import IO, Any
 import numpy as np
 
 from ai import make_guard_ai, make_player_policy
+from ai.stimuli import load_stimulus
 from navmesh.level import Level, load_level
 
 from .config import Config
@@ -42,15 +43,18 @@ class TrialSpec:
     seed: int = 0
     overrides: tuple[tuple[str, Any], ...] = ()
     root_seed: int = 0
+    #: extra stimuli: ``"path/to/file.py:Name"`` or installed entry-point names (docs/mechanics.md)
+    stimuli: tuple[str, ...] = ()
 
     @property
     def key(self) -> str:
         """A unique, human-readable key of this trial (used by the results store)."""
         extra = ",".join(f"{k}={v}" for k, v in self.overrides)
-        return "/".join(
-            [self.level, self.abstraction, self.guards, self.player, self.scenario,
-             str(self.seed), str(self.root_seed), extra]
-        )
+        parts = [self.level, self.abstraction, self.guards, self.player, self.scenario,
+                 str(self.seed), str(self.root_seed), extra]
+        if self.stimuli:  # only then, so the keys of trials without plugins do not change
+            parts.append("stimuli=" + "+".join(self.stimuli))
+        return "/".join(parts)
 
 
 def trial_rngs(spec: TrialSpec, level_name: str) -> tuple[np.random.Generator, ...]:
@@ -80,6 +84,8 @@ def make_world(spec: TrialSpec, config: Config | None = None, **world_kwargs: An
     """Build the world of a trial (level and graph are cached per process)."""
     config = config or Config.load(dict(spec.overrides))
     level = _cached_level(spec.level)
+    if spec.stimuli:
+        world_kwargs.setdefault("stimuli", [load_stimulus(s) for s in spec.stimuli])
     return World(
         level,
         spec.abstraction,
@@ -125,7 +131,8 @@ def run_trial(
         world.on_tick = write
     metrics = world.run()
     return {
-        **{k: v for k, v in asdict(spec).items() if k != "overrides"},
+        **{k: v for k, v in asdict(spec).items() if k not in ("overrides", "stimuli")},
+        **({"stimuli": list(spec.stimuli)} if spec.stimuli else {}),
         "level": world.level.name,
         "overrides": dict(spec.overrides),
         "config_hash": config.hash(),
@@ -146,6 +153,7 @@ def sim_document(row: Mapping[str, Any]) -> dict[str, Any]:
         "scenario": row["scenario"],
         "seed": row["seed"],
         "config_hash": row["config_hash"],
+        **({"stimuli": list(row["stimuli"])} if row.get("stimuli") else {}),
         "metrics": row["metrics"],
     }
 

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import math
 from collections import deque
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -19,6 +19,14 @@ import pymunk
 import shapely
 
 from ai import GuardAI, PlayerPolicy, WorldView
+from ai.stimuli import (
+    StimulusFactory,
+    StimulusParams,
+    StimulusSet,
+    apply_zones,
+    zone_view_scale,
+    zones_from_config,
+)
 from ai.view import Event
 from navmesh.graph import NodeGraph, graph_for
 from navmesh.level import Level
@@ -78,6 +86,16 @@ class Agent:
         return not self.waypoints
 
 
+class Refused(str):
+    """Why a player action did not happen: a message that is false in a boolean test.
+
+    ``if world.throw_decoy(x, y): ...`` reads naturally, and the front end shows the text.
+    """
+
+    def __bool__(self) -> bool:
+        return False
+
+
 @dataclass
 class Metrics:
     """Counters of one trial (SPEC §7); :meth:`World.metrics` turns them into the JSON row."""
@@ -115,6 +133,7 @@ class World:
         rngs: tuple[np.random.Generator, np.random.Generator, np.random.Generator] | None = None,
         interactive: bool = False,
         graph: NodeGraph | None = None,
+        stimuli: Sequence[StimulusFactory] = (),
     ) -> None:
         if scenario not in SCENARIOS:
             raise ValueError(f"unknown scenario {scenario!r} (choose capture or fixed)")
@@ -139,12 +158,18 @@ class World:
         self.hp_max = float(w["player_hp"])
         self.stuck_timeout = float(w["stuck_timeout"])
         self.sprint_factor = float(w["sprint_factor"])
-        self.concealment_view_scale = float(config["zones.concealment_view_scale"])
+        # Zones (SPEC §5) say what they do to confidence decay and view range (ai.stimuli.Zone).
+        self.zone_rules = zones_from_config(config.section("zones"))
+        concealment = self.zone_rules.get("concealment")
+        self.concealment_view_scale = concealment.view_scale if concealment else 1.0
+        self.stimulus_params = StimulusParams.from_mapping(config.section("stimuli"))
         # HP is tracked in integer guard-steps of damage so it never drifts with float sums.
         self.damage_steps = 0
         self.lethal_steps = round(self.hp_max / self.dt)
 
         self.zones = self._zone_masks()
+        self.view_scale_at = zone_view_scale(self.zone_rules, self.zones, self.graph.n)
+        self._watched: frozenset[int] = frozenset()
         self.space = self._build_space()
         self.step_index = 0
         self.done = False
@@ -153,6 +178,7 @@ class World:
         self.sighting: int | None = None
         self.seen_by: tuple[int, ...] = ()
         self.sprinting = False
+        self._sprinted = False
         self.player_input: tuple[float, float] | None = None
         self.on_tick: Callable[[World], None] | None = None
 
@@ -178,6 +204,24 @@ class World:
         for guard in self.guards:
             self._enter_node(guard, guard.node, count_visit=True)
             guard.history.append(guard.node)
+
+        # Stimuli (ai.stimuli): world events become field layers for the guard AI's hooks.
+        apply_zones(self.guard_ai, self.zone_rules, self.zones)
+        self.stimuli = StimulusSet(
+            self.graph, self.stimulus_params, guard_ai=self.guard_ai,
+            rng=spawn_rng.spawn(1)[0], zones=self.zones,
+        )
+        self.decoy_points = [(float(x), float(y)) for x, y in level.decoys]
+        self.decoy_nodes = [self.graph.node_at(x, y) for x, y in self.decoy_points]
+        self._next_throw = 0.0
+        self._raining = False
+        if self.stimulus_params.raining:
+            self._set_rain(True, immediately=True)
+        for factory in stimuli:
+            self.stimuli.add(factory())
+        self.stimuli.refresh()
+        self._watched = self.stimuli.marked_nodes()
+
         self.attackers = 0
         self._dist_key: tuple[int, ...] = ()
         self._dist_now: float | None = None
@@ -267,7 +311,7 @@ class World:
         gx, gy = guard.pos
         dx, dy = target[0] - gx, target[1] - gy
         d2 = dx * dx + dy * dy
-        reach = self.view_range * self._concealment_factor() + RANGE_EPS
+        reach = self.view_range * self._zone_view_factor() + RANGE_EPS
         if d2 > reach * reach:
             return False
         d = math.sqrt(d2)
@@ -277,11 +321,9 @@ class World:
             return False
         return self._clear_line((gx, gy), target)
 
-    def _concealment_factor(self) -> float:
-        mask = self.zones.get("concealment")
-        if mask is not None and mask[self.player.node]:
-            return self.concealment_view_scale
-        return 1.0
+    def _zone_view_factor(self) -> float:
+        """Factor on the view range from the zones the player stands in (concealment 0.7)."""
+        return float(self.view_scale_at[self.player.node])
 
     @property
     def hp(self) -> float:
@@ -396,6 +438,9 @@ class World:
         if count_visit and agent is not self.player:
             self.m.visits[node] += 1
             self.m.covered[node] = True
+            if node in self._watched and agent.active:
+                guard = next(i for i, g in enumerate(self.guards) if g is agent)
+                self.events.append(Event("guard_on", node, self.t, {"guard": guard}))
 
     # ------------------------------------------------------------------ the step
     def step(self) -> None:
@@ -423,6 +468,7 @@ class World:
             self._drive(self.player, player_speed)
 
         before = [a.pos for a in self.guards] + [self.player.pos]
+        sprint = self.sprinting
         self.space.step(self.dt)
         self.step_index += 1
         if self.attackers:
@@ -447,6 +493,8 @@ class World:
                 self._enter_node(agent, node, count_visit=True)
             if agent.waypoints and agent.since_target > self.stuck_timeout:
                 agent.waypoints.clear()  # re-plan from where it stands
+        if sprint and self.player.pos != before[-1]:
+            self._sprinted = True  # footsteps: the player moved while sprinting this tick
 
         self._sense()
         if self.step_index % self.steps_per_tick == 0:
@@ -500,12 +548,174 @@ class World:
 
     def _ai_tick(self) -> None:
         dt = self.steps_per_tick * self.dt
+        if self._sprinted:
+            self.events.append(Event("sprint", self.player.node, self.t))
+            self._sprinted = False
         self.tick_events = self.events
-        self.guard_ai.tick(self.view(), dt)
+        view = self.view()
+        self.stimuli.tick(view, dt)  # before the guard AI's tick, so FSM reacts to new layers
+        self.guard_ai.tick(view, dt)
+        self._watched = self.stimuli.marked_nodes()
         self.events = []
         self.sighting = None
         if self.on_tick is not None:
             self.on_tick(self)
+
+    # ------------------------------------------------------------------ player actions
+    # SPEC §5 mechanics the player triggers. Each returns True when it happened, else a
+    # :class:`Refused` message (false in a boolean test). An action raises an event; the
+    # stimulus it makes enters the fields at the next AI tick, like everything in the fields.
+
+    def emit(self, kind: str, node: int = -1, **data: Any) -> Event:
+        """Raise a world event now (scripted scenarios, tests); stimuli see it at the next tick."""
+        event = Event(kind, int(node), self.t, data)
+        self.events.append(event)
+        return event
+
+    def _cell(self, x: float, y: float) -> tuple[int, int]:
+        cs = self.level.cell_size
+        return math.floor(y / cs), math.floor(x / cs)
+
+    def _node_containing(self, x: float, y: float) -> int:
+        """The node whose walkable cell or triangle contains (x, y); -1 in a wall or outside."""
+        if not (math.isfinite(x) and math.isfinite(y)):
+            return -1
+        graph = self.graph
+        if graph.cell_node is not None:
+            row, col = math.floor(y / graph.cell_size), math.floor(x / graph.cell_size)
+            rows, cols = graph.cell_node.shape
+            return int(graph.cell_node[row, col]) if 0 <= row < rows and 0 <= col < cols else -1
+        if graph.mesh is not None:
+            return int(graph.mesh.locate(x, y))
+        return graph.node_at(x, y) if self.level.contains(x, y) else -1
+
+    def landing_node(self, x: float, y: float) -> int:
+        """Where a decoy thrown at (x, y) lands (SPEC §5: within the Manhattan throw radius).
+
+        The node containing the point if it is walkable and its cell lies within
+        ``throw_radius`` cells (Manhattan) of the player's cell; otherwise the point is
+        clamped to the nearest node (straight line) whose position is within that radius.
+        """
+        radius = self.stimulus_params.throw_radius
+        prow, pcol = self._cell(*self.player.pos)
+        node = self._node_containing(float(x), float(y))
+        if node >= 0:
+            row, col = self._cell(float(x), float(y))
+            if abs(row - prow) + abs(col - pcol) <= radius:
+                return node
+        cs = self.level.cell_size
+        cells = np.floor(self.graph.positions / cs).astype(np.int64)
+        near = np.abs(cells[:, 1] - prow) + np.abs(cells[:, 0] - pcol) <= radius
+        options = np.flatnonzero(near)
+        if not len(options):
+            return self.player.node
+        if not (math.isfinite(x) and math.isfinite(y)):
+            x, y = self.player.pos
+        d2 = np.sum((self.graph.positions[options] - (x, y)) ** 2, axis=1)
+        return int(options[np.argmin(d2)])
+
+    def throw_decoy(self, x: float, y: float) -> bool | Refused:
+        """Throw a decoy towards (x, y): a noise impulse where it lands; 10 s cooldown."""
+        if self.done:
+            return Refused("the trial is over")
+        if self.t < self._next_throw - 1e-9:
+            return Refused(f"cooldown, {self._next_throw - self.t:.1f} s left")
+        node = self.landing_node(float(x), float(y))
+        lx, ly = (float(v) for v in self.graph.positions[node])
+        self._next_throw = self.t + self.stimulus_params.throw_cooldown
+        self.emit("throw_landed", node, x=lx, y=ly, target=[float(x), float(y)])
+        return True
+
+    def _decoy_on(self, k: int) -> bool:
+        pending = any(e.kind == "decoy_activated" and e.data.get("decoy") == k for e in self.events)
+        return pending or any(getattr(s, "decoy", None) == k for s in self.stimuli.active)
+
+    def activate_decoy(self) -> bool | Refused:
+        """Switch on the nearest level decoy within ``decoy_reach`` (line of sight) of the player.
+
+        It draws the guards until they have stood on it for ``decoy_disarm_time``; then it
+        can be switched on again.
+        """
+        if self.done:
+            return Refused("the trial is over")
+        reach = self.stimulus_params.decoy_reach + RANGE_EPS
+        px, py = self.player.pos
+        options = sorted(
+            (math.hypot(x - px, y - py), k) for k, (x, y) in enumerate(self.decoy_points)
+            if math.hypot(x - px, y - py) <= reach and self._clear_line((px, py), (x, y))
+        )
+        if not options:
+            return Refused("no decoy within reach")
+        free = [k for _, k in options if not self._decoy_on(k)]
+        if not free:
+            return Refused("the decoy is already on")
+        self.emit("decoy_activated", self.decoy_nodes[free[0]], decoy=free[0])
+        return True
+
+    def take_down(self) -> bool | Refused:
+        """Take down the nearest guard within ``takedown_range`` whose view cone the player is
+        outside of (from behind or the side), with no wall between; its body becomes a corpse."""
+        if self.done:
+            return Refused("the trial is over")
+        reach = self.stimulus_params.takedown_range + RANGE_EPS
+        px, py = self.player.pos
+        best: tuple[float, int] | None = None
+        for i, guard in enumerate(self.guards):
+            if not guard.active:
+                continue
+            gx, gy = guard.pos
+            dx, dy = px - gx, py - gy
+            d = math.hypot(dx, dy)
+            if d > reach:
+                continue
+            facing = dx * math.cos(guard.heading) + dy * math.sin(guard.heading)
+            if d > 1e-9 and facing >= self.cos_half_fov * d:
+                continue  # the player is inside this guard's view cone
+            if not self._clear_line((gx, gy), (px, py)):
+                continue
+            if best is None or d < best[0]:
+                best = (d, i)
+        if best is None:
+            return Refused("no guard within reach from behind")
+        self.down_guard(best[1])
+        return True
+
+    def down_guard(self, i: int) -> None:
+        """Take guard ``i`` out of play; its body stays where it is (raises ``"guard_down"``).
+
+        The player's :meth:`take_down` checks range and cone first; scripts may call this
+        directly.
+        """
+        guard = self.guards[i]
+        if not guard.active:
+            raise ValueError(f"guard {i} is already down")
+        guard.active = False
+        guard.waypoints.clear()
+        guard.set_velocity((0.0, 0.0))
+        self.emit("guard_down", guard.node, guard=int(i))
+
+    @property
+    def raining(self) -> bool:
+        """Whether it rains (noises made while it rains are quieter, SPEC §5)."""
+        return self._raining
+
+    def _set_rain(self, on: bool, immediately: bool = False) -> None:
+        self._raining = bool(on)
+        event = Event("weather", -1, self.t, {"rain": bool(on)})
+        if immediately:
+            self.stimuli.handle(event)
+        else:
+            self.events.append(event)
+
+    def toggle_rain(self) -> str:
+        """Start or stop the rain; returns ``"on"`` or ``"off"``."""
+        self._set_rain(not self._raining)
+        return "on" if self._raining else "off"
+
+    def stimulus_points(self) -> np.ndarray:
+        """Positions ``(k, 2)`` of the active decoys, corpses and landed throws, for drawing."""
+        nodes = [s.node for s in self.stimuli.markers()]
+        return self.graph.positions[nodes].reshape(-1, 2)
 
     # ------------------------------------------------------------------ results
     def run(self) -> dict[str, Any]:
@@ -552,6 +762,7 @@ class World:
                 {"kind": e.kind, "node": e.node, "t": _round(e.t), **dict(e.data)}
                 for e in self.tick_events
             ],
+            **({"stimuli": [s.describe() for s in self.stimuli.active]} if self.stimuli else {}),
         }
 
 

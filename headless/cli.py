@@ -23,10 +23,10 @@ class UserError(Exception):
 
 
 def _user_errors() -> tuple[type[BaseException], ...]:
+    from ai.stimuli import StimulusError
     from game.config import ConfigError
     from navmesh.level import LevelError
     from navmesh.mesh import OutsideError
-    from ai.stimuli import StimulusError
 
     return (UserError, LevelError, ConfigError, OutsideError, StimulusError)
 
@@ -136,10 +136,9 @@ def _overrides(items: Sequence[str]) -> tuple[tuple[str, Any], ...]:
 
 
 def cmd_sim(args: argparse.Namespace) -> int:
+    from ai.stimuli import load_stimulus
     from game.trial import TrialSpec, run_trial, sim_document
     from navmesh.level import load_level
-
-    from ai.stimuli import load_stimulus
 
     load_level(args.level)  # a bad level fails here with its one-line message
     for plugin in args.stimulus:

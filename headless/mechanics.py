@@ -1,0 +1,559 @@
+"""Measured effects of the stealth mechanics (``stealth mechanics``; docs/mechanics.md).
+
+The paper validated its seven mechanics by hand-guided playtests only. This experiment
+measures each one against a **paired control**: the same seed (so the same guard spawns,
+the same guard generator and the same player path) with the mechanic switched off, over
+``--seeds`` seeds (default 30). Every figure is a mean with a 95 % percentile bootstrap CI
+over seeds (2000 resamples; the difference is bootstrapped over the pairs).
+
+PF guards on one level and abstraction (default miami, grid). Unless a mechanic is about
+sight, the guards are *blind* (view range 0) and the player cannot be hurt, so a sighting
+never overrides the stimulus being measured. Scenario ``fixed`` speeds (× 1.0).
+
+| mechanic | arm "on" | control | per-seed measure |
+|---|---|---|---|
+| decoy | level decoy switched on at t = 0 at a node ≥ 8 hops from every guard | not switched on | a guard reaches it within 15 s; time to arrive (censored at 15 s) |
+| footstep | wandering player sprints (noise) | walks; same speed (sprint_factor 1) | mean nearest guard–player path distance over 30 s |
+| corpse | guard 0 taken down at t = 0, corpse rule on | taken down, no corpse | guard within 1 hop in 20 s; mean nearest hops in [0, 20] s; distance change after removal |
+| dark | dark cells decay C at 0.80 | 0.95 (= ρ) | visits per dark cell ÷ visits per lit cell, 60 s |
+| concealment | player still in a concealment cell (view × 0.7, decay 0.80) | same cell, no zone effect | detected within 30 s; time to first detection |
+| rain | one footstep at hop distance d = 1..7 from the nearest guard, raining | same, clear | draw distance: largest d with a guard within 1 hop of the source in 8 s at every d' ≤ d |
+
+Trials run in a process pool (``--workers``; 1 = in-process). Writes ``mechanics.md`` (the
+table), ``mechanics.csv`` (one row per measure) and ``mechanics_trials.csv`` (one row per
+seed and measure, both arms).
+"""
+
+from __future__ import annotations
+
+import argparse
+import concurrent.futures as cf
+import csv
+import math
+import os
+import sys
+import time
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass
+from functools import lru_cache
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from ai import make_guard_ai
+from ai.stimuli import footstep_rule
+from ai.view import Event, PlayerPolicy, WorldView
+from game.config import Config
+from game.trial import TrialSpec, trial_rngs
+from game.world import World
+from navmesh.graph import NodeGraph
+from navmesh.level import Level, load_level
+
+#: guards cannot see and the player cannot be hurt: only the mechanic informs the guards
+BLIND = {"world.view_range": 0.0, "world.attack_range": 0.0, "world.player_hp": 1.0e6}
+BOOTSTRAP = 2000
+
+
+# ---------------------------------------------------------------------------- helpers
+
+
+class WanderPlayer(PlayerPolicy):
+    """Walks at random without turning back, ignoring the guards.
+
+    Its path depends only on its generator, so both arms of a pair walk the same path.
+    """
+
+    policy = "wander"
+
+    def reset(self, graph: NodeGraph, rng: np.random.Generator) -> None:
+        self.graph, self.rng, self.previous = graph, rng, -1
+
+    def decide(self, view: WorldView) -> int:
+        node = int(view.player_node)
+        options = [int(v) for v in self.graph.neighbors[node] if v != self.previous]
+        options = options or [int(v) for v in self.graph.neighbors[node]] or [node]
+        self.previous = node
+        return options[int(self.rng.integers(len(options)))]
+
+
+@lru_cache(maxsize=8)
+def _level(name: str) -> Level:
+    return load_level(name)
+
+
+def make_world(
+    level: str, abstraction: str, seed: int, overrides: Mapping[str, Any], *,
+    player: PlayerPolicy | None = None, tag: str = "mechanics",
+) -> World:
+    """A PF world of the ``fixed`` scenario whose generators depend on (level, seed, tag) only."""
+    config = Config.load({k: str(v).lower() if isinstance(v, bool) else str(v)
+                          for k, v in overrides.items()})
+    lvl = _level(level)
+    spec = TrialSpec(level, abstraction, "pf", tag, "fixed", seed)
+    return World(lvl, abstraction, make_guard_ai("pf", config.section("pf")), player,
+                 config=config, scenario="fixed", rngs=trial_rngs(spec, lvl.name))
+
+
+def run_until(world: World, t_end: float, each_step: Callable[[World], None] | None = None) -> None:
+    """Step ``world`` until ``t_end`` seconds (calling ``each_step`` after every step)."""
+    while not world.done and world.t < t_end - 1e-9:
+        world.step()
+        if each_step is not None:
+            each_step(world)
+
+
+def active_guard_nodes(world: World) -> list[int]:
+    return [g.node for g in world.guards if g.active]
+
+
+# ---------------------------------------------------------------------------- the mechanics
+# Each returns {measure: {arm: value}} for one seed; arms "on", "control", optionally "baseline".
+
+Measures = dict[str, dict[str, float]]
+
+
+def decoy(level: str, abstraction: str, seed: int) -> Measures:
+    """Static decoy: share reaching it within 15 s, time to arrive (censored at 15 s)."""
+    horizon = 15.0
+    out = []
+    target = -1
+    for on in (True, False):
+        world = make_world(level, abstraction, seed, BLIND)
+        if target < 0:
+            far = world.graph.hops[active_guard_nodes(world)].min(axis=0) >= 8
+            options = np.flatnonzero(far) if far.any() else np.arange(world.graph.n)
+            target = int(options[world.stimuli.ctx.rng.integers(len(options))])
+        if on:
+            world.emit("decoy_activated", target)
+        arrival: list[float] = []
+
+        def watch(w: World, arrival: list[float] = arrival, target: int = target) -> None:
+            if not arrival and target in active_guard_nodes(w):
+                arrival.append(w.t)
+
+        run_until(world, horizon, watch)
+        out.append((float(bool(arrival)), arrival[0] if arrival else horizon))
+    return {
+        "decoy: a guard reaches it within 15 s (share)": {"on": out[0][0], "control": out[1][0]},
+        "decoy: time to arrive, s (censored at 15)": {"on": out[0][1], "control": out[1][1]},
+    }
+
+
+def footstep(level: str, abstraction: str, seed: int) -> Measures:
+    """Footstep noise: nearest guard–player path distance while the player sprints vs walks."""
+    horizon = 30.0
+    values = []
+    for sprint in (True, False):
+        world = make_world(level, abstraction, seed, {**BLIND, "world.sprint_factor": 1.0},
+                           player=WanderPlayer())
+        world.sprinting = sprint
+        run_until(world, horizon)
+        values.append(float(world.metrics()["avg_guard_player_dist"]))
+    return {"footstep: mean nearest guard-player distance, units":
+            {"on": values[0], "control": values[1]}}
+
+
+def corpse(level: str, abstraction: str, seed: int) -> Measures:
+    """Corpse: convergence in the first 20 s, dispersal after the inspection removed it."""
+    horizon, window = 50.0, 10
+    tracks: list[np.ndarray] = []
+    removal: float | None = None
+    for on in (True, False):
+        world = make_world(level, abstraction, seed, BLIND)
+        if not on:
+            world.stimuli.disable("guard_down")
+        body = world.guards[0].node
+        world.down_guard(0)
+        track: list[float] = []
+        found = [False]
+
+        def watch(w: World, on: bool = on, track: list[float] = track,
+                  found: list[bool] = found, body: int = body) -> None:
+            nonlocal removal
+            if w.step_index % w.steps_per_tick:
+                return
+            track.append(float(w.graph.hops[active_guard_nodes(w), body].min()))
+            present = any(s.name == "corpse" for s in w.stimuli.active)
+            if on and present:
+                found[0] = True
+            elif on and found[0] and not present and removal is None:
+                removal = w.t
+
+        run_until(world, horizon, watch)
+        tracks.append(np.array(track))  # track[k]: nearest hops at t = k + 1 s
+    near = [float(np.any(t[:20] <= 1)) for t in tracks]
+    mean20 = [float(t[:20].mean()) for t in tracks]
+    result = {
+        "corpse: a guard within 1 hop within 20 s (share)": {"on": near[0], "control": near[1]},
+        "corpse: mean nearest guard hops, first 20 s": {"on": mean20[0], "control": mean20[1]},
+    }
+    if removal is not None and removal + window <= horizon:
+        k = round(removal) - 1  # index of the removal tick
+        change = [float(t[k + 1: k + 1 + window].mean() - t[max(0, k - window) + 1: k + 1].mean())
+                  for t in tracks]
+        result["corpse: nearest hops, 10 s after removal minus 10 s before"] = {
+            "on": change[0], "control": change[1]}
+    return result
+
+
+def dark(level: str, abstraction: str, seed: int) -> Measures:
+    """Lighting: visits per dark cell ÷ visits per lit cell over 60 s."""
+    ratios = []
+    for rate in (None, 0.95):
+        overrides = dict(BLIND)
+        if rate is not None:
+            overrides["zones.dark_confidence_decay"] = rate
+        world = make_world(level, abstraction, seed, overrides)
+        run_until(world, 60.0)
+        mask = world.zones.get("dark", np.zeros(world.graph.n, bool))
+        visits = world.m.visits.astype(float)
+        lit = visits[~mask].mean() if (~mask).any() else 0.0
+        ratios.append(float(visits[mask].mean() / lit) if mask.any() and lit > 0 else math.nan)
+    return {"dark: visits per dark cell / per lit cell, 60 s": {"on": ratios[0], "control": ratios[1]}}
+
+
+def concealment(level: str, abstraction: str, seed: int) -> Measures:
+    """Concealment: a still player in a concealment cell, detected or not within 30 s."""
+    horizon = 30.0
+    out = []
+    spot = -1
+    for on in (True, False):
+        overrides: dict[str, Any] = {"world.player_hp": 1.0e6}
+        if not on:
+            overrides.update({"zones.concealment_view_scale": 1.0,
+                              "zones.concealment_confidence_decay": 0.95})
+        world = make_world(level, abstraction, seed, overrides)
+        if spot < 0:
+            mask = world.zones.get("concealment")
+            if mask is None or not mask.any():
+                raise ValueError(f"level {level} has no concealment zone")
+            options = np.flatnonzero(mask)
+            spot = int(options[world.stimuli.ctx.rng.integers(len(options))])
+        world.player.place(tuple(float(v) for v in world.graph.positions[spot]))
+        world.player.node = spot
+        world.m.first_detect_time = None
+
+        seen_from: list[float] = []
+
+        def stop_when_seen(w: World, seen_from: list[float] = seen_from) -> None:
+            if w.seen_by:
+                px, py = w.player.pos
+                seen_from.append(min(math.hypot(w.guards[i].pos[0] - px, w.guards[i].pos[1] - py)
+                                     for i in w.seen_by))
+                w.done = True
+
+        run_until(world, horizon, stop_when_seen)
+        first = world.m.first_detect_time
+        out.append((float(first is not None), horizon if first is None else float(first),
+                    seen_from[0] if seen_from else math.nan))
+    return {
+        "concealment: detected within 30 s (share)": {"on": out[0][0], "control": out[1][0]},
+        "concealment: time to first detection, s (censored at 30)":
+            {"on": out[0][1], "control": out[1][1]},
+        "concealment: distance of the guard at first detection, units":
+            {"on": out[0][2], "control": out[1][2]},
+    }
+
+
+DRAW_DISTANCES = tuple(range(1, 9))
+
+
+def _draw(level: str, abstraction: str, seed: int, d: int, sound: str) -> float:
+    """One footstep ``d`` hops from the nearest guard at t = 1 s (``sound``: clear, rain or
+    none): 1.0 if a guard steps onto its source within d/2 + 3 s (the walk plus 3 s)."""
+    world = make_world(level, abstraction, seed, {**BLIND, "stimuli.raining": sound == "rain"})
+    run_until(world, 1.0)
+    nearest = world.graph.hops[active_guard_nodes(world)].min(axis=0)
+    options = np.flatnonzero(nearest == d)
+    if not len(options):
+        return math.nan
+    source = int(options[world.stimuli.ctx.rng.integers(len(options))])
+    if sound != "none":
+        world.stimuli.add(footstep_rule(Event("sprint", source, world.t), world.stimuli.ctx))
+        world.stimuli.refresh()
+    hit: list[bool] = []
+
+    def watch(w: World) -> None:
+        if not hit and source in active_guard_nodes(w):
+            hit.append(True)
+
+    run_until(world, 1.0 + d / 2 + 3.0, watch)
+    return float(bool(hit))
+
+
+def rain(level: str, abstraction: str, seed: int) -> Measures:
+    """Rain: how far one footstep draws a guard onto its source, raining vs clear (vs none)."""
+    arms = {"on": "rain", "control": "clear", "baseline": "none"}
+    curve = {arm: [_draw(level, abstraction, seed, d, sound) for d in DRAW_DISTANCES]
+             for arm, sound in arms.items()}
+    result: Measures = {
+        f"curve: footstep {d} hops away draws a guard": {arm: curve[arm][k] for arm in arms}
+        for k, d in enumerate(DRAW_DISTANCES)
+    }
+    share = {arm: float(np.nanmean(values)) if not np.all(np.isnan(values)) else math.nan
+             for arm, values in curve.items()}
+    result["rain: share of footsteps 1-8 hops away that draw a guard"] = {
+        "on": share["on"], "control": share["control"]}
+    result["footstep: share of single footsteps 1-8 hops away that draw a guard"] = {
+        "on": share["control"], "control": share["baseline"]}
+    return result
+
+
+MECHANICS: dict[str, Callable[[str, str, int], Measures]] = {
+    "decoy": decoy,
+    "footstep": footstep,
+    "corpse": corpse,
+    "dark": dark,
+    "concealment": concealment,
+    "rain": rain,
+}
+
+#: the direction each measure should move when the mechanic is on: +1 up, -1 down
+EXPECTED: dict[str, int] = {
+    "decoy: a guard reaches it within 15 s (share)": +1,
+    "decoy: time to arrive, s (censored at 15)": -1,
+    "footstep: mean nearest guard-player distance, units": -1,
+    "footstep: share of single footsteps 1-8 hops away that draw a guard": +1,
+    "corpse: a guard within 1 hop within 20 s (share)": +1,
+    "corpse: mean nearest guard hops, first 20 s": -1,
+    "corpse: nearest hops, 10 s after removal minus 10 s before": +1,
+    "dark: visits per dark cell / per lit cell, 60 s": +1,
+    "concealment: detected within 30 s (share)": -1,
+    "concealment: time to first detection, s (censored at 30)": +1,
+    "concealment: distance of the guard at first detection, units": -1,
+    "rain: share of footsteps 1-8 hops away that draw a guard": -1,
+}
+
+Row = tuple[str, int, str, float]  # measure, seed, arm, value
+
+
+def run_job(job: tuple[str, str, str, int]) -> list[Row]:
+    """One (mechanic, level, abstraction, seed): every arm. Top-level, picklable."""
+    mechanic, level, abstraction, seed = job
+    measures = MECHANICS[mechanic](level, abstraction, seed)
+    return [(measure, seed, arm, value) for measure, arms in measures.items()
+            for arm, value in arms.items()]
+
+
+# ---------------------------------------------------------------------------- statistics
+
+
+def bootstrap_ci(values: np.ndarray, rng: np.random.Generator, n: int = BOOTSTRAP) -> tuple[float, float]:
+    """95 % percentile bootstrap CI of the mean of ``values`` (resampling seeds)."""
+    values = np.asarray(values, dtype=float)
+    if len(values) == 0:
+        return (math.nan, math.nan)
+    means = values[rng.integers(len(values), size=(n, len(values)))].mean(axis=1)
+    low, high = np.percentile(means, [2.5, 97.5])
+    return float(low), float(high)
+
+
+@dataclass
+class Summary:
+    """One measure over the seeds: both arms and their paired difference, with CIs."""
+
+    measure: str
+    n: int
+    on: float
+    on_ci: tuple[float, float]
+    control: float
+    control_ci: tuple[float, float]
+    diff: float
+    diff_ci: tuple[float, float]
+    expected: int
+
+    @property
+    def verdict(self) -> str:
+        """``yes`` when the difference's CI lies wholly on the intended side of 0."""
+        if self.n == 0:
+            return "no data"
+        if self.expected * self.diff_ci[0] > 0 and self.expected * self.diff_ci[1] > 0:
+            return "yes"
+        if self.expected * self.diff > 0:
+            return "same way, CI spans 0"
+        return "NO"
+
+
+def _arms(rows: Sequence[Row]) -> dict[str, dict[int, dict[str, float]]]:
+    table: dict[str, dict[int, dict[str, float]]] = {}
+    for measure, seed, arm, value in rows:
+        table.setdefault(measure, {}).setdefault(seed, {})[arm] = value
+    return table
+
+
+def _rng() -> np.random.Generator:
+    return np.random.Generator(np.random.PCG64(np.random.SeedSequence(20240101)))
+
+
+def summarise(rows: Sequence[Row]) -> list[Summary]:
+    """Per measure of :data:`EXPECTED`: means, bootstrap CIs and the paired difference."""
+    rng = _rng()
+    table = _arms(rows)
+    out = []
+    for measure, expected in EXPECTED.items():
+        pairs = np.array(
+            [(a["on"], a["control"]) for _, a in sorted(table.get(measure, {}).items())
+             if math.isfinite(a.get("on", math.nan)) and math.isfinite(a.get("control", math.nan))],
+            dtype=float,
+        ).reshape(-1, 2)
+        on, control = pairs[:, 0], pairs[:, 1]
+
+        def mean(v: np.ndarray) -> float:
+            return float(v.mean()) if len(v) else math.nan
+
+        out.append(Summary(measure, len(pairs), mean(on), bootstrap_ci(on, rng), mean(control),
+                           bootstrap_ci(control, rng), mean(on - control),
+                           bootstrap_ci(on - control, rng), expected))
+    return out
+
+
+def draw_curve(rows: Sequence[Row]) -> list[dict[str, Any]]:
+    """Per distance d: the share of footsteps that drew a guard, per sound (rain/clear/none)."""
+    rng = _rng()
+    table = _arms(rows)
+    out = []
+    for d in DRAW_DISTANCES:
+        per_seed = table.get(f"curve: footstep {d} hops away draws a guard", {})
+        entry: dict[str, Any] = {"d": d}
+        for arm, sound in (("baseline", "none"), ("control", "clear"), ("on", "rain")):
+            values = np.array([a[arm] for a in per_seed.values()
+                               if math.isfinite(a.get(arm, math.nan))])
+            entry[sound] = (float(values.mean()) if len(values) else math.nan,
+                            bootstrap_ci(values, rng), len(values))
+        out.append(entry)
+    return out
+
+
+def draw_distance(curve: Sequence[Mapping[str, Any]], sound: str, share: float = 0.5) -> int:
+    """The largest d such that at every d' ≤ d at least ``share`` of the footsteps drew a
+    guard (0: not even at 1 hop)."""
+    best = 0
+    for entry in curve:
+        value = entry[sound][0]
+        if not (math.isfinite(value) and value >= share):
+            break
+        best = int(entry["d"])
+    return best
+
+
+def _fmt(value: float, ci: tuple[float, float]) -> str:
+    if not math.isfinite(value):
+        return "–"
+    return f"{value:.2f} [{ci[0]:.2f}, {ci[1]:.2f}]"
+
+
+def markdown(summaries: Sequence[Summary], curve: Sequence[Mapping[str, Any]], level: str,
+             abstraction: str, seeds: int, seconds: float) -> str:
+    """The results as Markdown: the effects table and the footstep draw curve."""
+    lines = [
+        f"Level {level}, {abstraction}, PF guards, {seeds} paired seeds; mean [95 % bootstrap "
+        f"CI over seeds]; computed in {seconds:.0f} s.",
+        "",
+        "| measure | n | mechanic on | control | on − control | intended | as intended |",
+        "|---|---|---|---|---|---|---|",
+    ]
+    for s in summaries:
+        arrow = "↑" if s.expected > 0 else "↓"
+        lines.append(f"| {s.measure} | {s.n} | {_fmt(s.on, s.on_ci)} | "
+                     f"{_fmt(s.control, s.control_ci)} | {_fmt(s.diff, s.diff_ci)} | {arrow} | "
+                     f"{s.verdict} |")
+    if curve:
+        lines += [
+            "",
+            "Share of single footsteps d hops from the nearest guard that draw a guard onto "
+            "their source within d/2 + 3 s:",
+            "",
+            "| d (hops) | no noise | clear | rain |",
+            "|---|---|---|---|",
+        ]
+        for entry in curve:
+            cells = [_fmt(entry[s][0], entry[s][1]) for s in ("none", "clear", "rain")]
+            lines.append(f"| {entry['d']} | " + " | ".join(cells) + " |")
+        lines += [
+            "",
+            f"Draw distance (largest d up to which at least half the footsteps draw a guard): "
+            f"no noise {draw_distance(curve, 'none')}, clear {draw_distance(curve, 'clear')}, "
+            f"rain {draw_distance(curve, 'rain')} hops.",
+        ]
+    return "\n".join(lines) + "\n"
+
+
+# ---------------------------------------------------------------------------- running
+
+
+def run_mechanics(
+    seeds: int = 30, level: str = "miami", abstraction: str = "grid", workers: int | None = None,
+    mechanics: Sequence[str] | None = None, progress: bool = True,
+) -> tuple[list[Row], float]:
+    """Every (mechanic, seed) with all its arms; returns the rows and the seconds it took."""
+    names = list(mechanics or MECHANICS)
+    jobs = [(m, level, abstraction, s) for s in range(seeds) for m in names]
+    started = time.perf_counter()
+    rows: list[Row] = []
+    workers = workers or min(len(jobs), os.cpu_count() or 1)
+
+    progress = progress and sys.stderr.isatty()
+
+    def collect(result: list[Row], done: int) -> None:
+        rows.extend(result)
+        if progress:
+            print(f"\rmechanics: {done}/{len(jobs)} seed x mechanic", end="", file=sys.stderr,
+                  flush=True)
+
+    if workers <= 1:
+        for k, job in enumerate(jobs, 1):
+            collect(run_job(job), k)
+    else:
+        with cf.ProcessPoolExecutor(max_workers=workers) as pool:
+            for k, result in enumerate(pool.map(run_job, jobs, chunksize=2), 1):
+                collect(result, k)
+    if progress:
+        print(file=sys.stderr)
+    rows.sort(key=lambda r: (r[0], r[1], r[2]))
+    return rows, time.perf_counter() - started
+
+
+def write_results(out: Path, rows: Sequence[Row], summaries: Sequence[Summary], table: str) -> None:
+    """``mechanics.md``, ``mechanics.csv`` (one row per measure), ``mechanics_trials.csv``."""
+    out.mkdir(parents=True, exist_ok=True)
+    (out / "mechanics.md").write_text("# Measured effects of the stealth mechanics\n\n" + table,
+                                      encoding="utf-8")
+    with (out / "mechanics.csv").open("w", newline="", encoding="utf-8") as handle:
+        writer = csv.writer(handle)
+        writer.writerow(["measure", "n", "on", "on_lo", "on_hi", "control", "control_lo",
+                         "control_hi", "diff", "diff_lo", "diff_hi", "intended", "as_intended"])
+        for s in summaries:
+            writer.writerow([s.measure, s.n, s.on, *s.on_ci, s.control, *s.control_ci, s.diff,
+                             *s.diff_ci, "up" if s.expected > 0 else "down", s.verdict])
+    with (out / "mechanics_trials.csv").open("w", newline="", encoding="utf-8") as handle:
+        writer = csv.writer(handle)
+        writer.writerow(["measure", "seed", "arm", "value"])
+        writer.writerows(rows)
+
+
+def cmd_mechanics(args: argparse.Namespace) -> int:
+    """``stealth mechanics``: run the paired experiment, write the files, print the table."""
+    if args.seeds < 2:
+        print("stealth: error: --seeds: need at least 2 seeds", file=sys.stderr)
+        return 2
+    if args.workers is not None and args.workers < 1:
+        print(f"stealth: error: --workers: must be at least 1, got {args.workers}", file=sys.stderr)
+        return 2
+    try:
+        level = load_level(args.level)
+    except ValueError as error:
+        print(f"stealth: error: {error}", file=sys.stderr)
+        return 2
+    rows, seconds = run_mechanics(args.seeds, args.level, args.abstraction, args.workers)
+    table = markdown(summarise(rows), draw_curve(rows), level.name, args.abstraction,
+                     args.seeds, seconds)
+    write_results(Path(args.out), rows, summarise(rows), table)
+    print(table, end="")
+    print(f"stealth: wrote {Path(args.out) / 'mechanics.md'}, mechanics.csv and "
+          f"mechanics_trials.csv", file=sys.stderr)
+    return 0
+
+
+__all__ = ["EXPECTED", "MECHANICS", "WanderPlayer", "cmd_mechanics", "draw_curve", "make_world",
+           "run_mechanics", "summarise"]
