@@ -357,12 +357,18 @@ class CompositeField:
         return self.matrices.candidates[node]
 
     def select(
-        self, node: int, rng: np.random.Generator, teammates: Sequence[int] | np.ndarray = ()
+        self,
+        node: int,
+        rng: np.random.Generator,
+        teammates: Sequence[int] | np.ndarray = (),
+        recent: Sequence[int] | np.ndarray = (),
     ) -> Choice:
         """argmin K over the candidates of ``node`` (eq. 7); ties within tie_eps drawn with ``rng``.
 
         ``teammates`` are the other active guards' current nodes: their presence term
         ``w_C · teammate_presence · C0 · (Kmat @ γ_C^d(g, ·))`` is added to K (docs/ai.md).
+        ``recent`` are the deciding guard's last visited nodes: a candidate among them gets
+        ``w_C · revisit_penalty · C0`` added (eq. 10, unsmoothed, docs/ai.md).
         """
         candidates = self.matrices.candidates[node]
         if len(candidates) == 0:
@@ -373,15 +379,31 @@ class CompositeField:
         if len(teammates) and scale:
             presence = self.matrices.presence[np.asarray(teammates, dtype=np.intp)]
             scores = scores + scale * presence[:, candidates].sum(axis=0)
+        revisit = self.revisit_term(candidates, recent)
+        if revisit is not None:
+            scores = scores + revisit
         tied = candidates[scores - scores.min() < self.params.tie_eps]
         winner = tied[0] if len(tied) == 1 else tied[rng.integers(len(tied))]
         return Choice(int(winner), candidates, scores, tied)
 
     def choose(
-        self, node: int, rng: np.random.Generator, teammates: Sequence[int] | np.ndarray = ()
+        self,
+        node: int,
+        rng: np.random.Generator,
+        teammates: Sequence[int] | np.ndarray = (),
+        recent: Sequence[int] | np.ndarray = (),
     ) -> int:
         """The next node of a guard at ``node``: :meth:`select`'s winner."""
-        return self.select(node, rng, teammates).winner
+        return self.select(node, rng, teammates, recent).winner
+
+    def revisit_term(
+        self, candidates: np.ndarray, recent: Sequence[int] | np.ndarray
+    ) -> np.ndarray | None:
+        """Eq. 10: ``w_C · revisit_penalty · C0`` on candidates among ``recent`` (else None)."""
+        scale = self.w_C * self.params.revisit_penalty * self.params.C0
+        if not len(recent) or not scale:
+            return None
+        return scale * np.isin(candidates, np.asarray(recent, dtype=np.intp))
 
     def teammate_confidence(self, teammates: Sequence[int] | np.ndarray) -> np.ndarray:
         """C_live (n,): teammates' deposit at their current nodes × teammate_presence."""

@@ -99,9 +99,13 @@ class PFParams(_Params):
     #: scale of the teammates' confidence deposit at their *current* nodes, added when a guard
     #: decides (docs/ai.md "Teammate presence"); 0 = the paper's field only
     teammate_presence: float = 1.0
+    #: penalty, in units of w_C·C0, on a candidate among the guard's last 5 decided nodes
+    #: (docs/ai.md "Revisit penalty"); 0 = the paper's field only
+    revisit_penalty: float = 0.5
 
     _ranges = {
         "teammate_presence": _NON_NEGATIVE,
+        "revisit_penalty": _NON_NEGATIVE,
         "I0": _NON_NEGATIVE,
         "C0": _NON_NEGATIVE,
         "gamma_I": _UNIT,

@@ -7,6 +7,7 @@ candidate set; ``explain`` says why, in plain JSON-able types.
 
 from __future__ import annotations
 
+from collections import deque
 from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any
@@ -34,6 +35,7 @@ class _Decision:
     kernel: np.ndarray
     weights: tuple[float, float, float]
     teammates: np.ndarray
+    recent: tuple[int, ...]
 
 
 class PotentialFieldGuards(GuardAI):
@@ -64,6 +66,8 @@ class PotentialFieldGuards(GuardAI):
         self.graph, self.rng, self.n_guards = graph, rng, n_guards
         self.field = CompositeField(graph, self.config)
         self._last: list[_Decision | None] = [None] * n_guards
+        #: each guard's last 5 decided nodes (the window the backtrack metric uses)
+        self._recent: list[deque[int]] = [deque(maxlen=5) for _ in range(n_guards)]
 
     def tick(self, view: WorldView, dt: float) -> None:
         """Decay and refresh I and C, adapt the weights (eqs. 1–3, 8)."""
@@ -80,7 +84,10 @@ class PotentialFieldGuards(GuardAI):
             field.tick(0.0, active_guard_nodes(view), sighting_node(view))
         node = int(view.guard_nodes[i])
         teammates = _teammate_nodes(view, i)
-        choice = field.select(node, self.rng, teammates)
+        recent = self._recent[i]
+        if not recent or recent[-1] != node:
+            recent.append(node)
+        choice = field.select(node, self.rng, teammates, recent)
         self._last[i] = _Decision(
             t=float(view.t),
             node=node,
@@ -92,6 +99,7 @@ class PotentialFieldGuards(GuardAI):
             kernel=field.kernel(),
             weights=field.weights,
             teammates=teammates,
+            recent=tuple(recent),
         )
         return choice.winner
 
@@ -125,7 +133,9 @@ class PotentialFieldGuards(GuardAI):
         Plain Python types only (JSON-able); None before the guard's first decision. For
         every candidate ``P = w_I·(I + I_extra) + w_C·(C + C_live) + w_N·N`` (C_live: the
         teammates' presence at their current nodes), ``K`` is the kernel average of that P
-        over the candidate's hop ball, and the winner has the least K.
+        over the candidate's hop ball plus ``revisit`` (eq. 10: ``w_C·revisit_penalty·C0``
+        when the candidate is among the guard's last 5 nodes, listed in ``recent``), and
+        the winner has the least K.
         """
         record = self._last[i] if 0 <= i < len(self._last) else None
         if record is None:
@@ -133,6 +143,7 @@ class PotentialFieldGuards(GuardAI):
         w_I, w_C, w_N = record.weights  # noqa: N806 — the paper's symbols
         connectivity = self.field.connectivity
         live = self.field.teammate_confidence(record.teammates)
+        revisit_unit = w_C * self.config.revisit_penalty * self.config.C0
         candidates = [
             {
                 "node": int(c),
@@ -142,6 +153,7 @@ class PotentialFieldGuards(GuardAI):
                 "C_live": float(live[c]),
                 "N": float(connectivity[c]),
                 "P": float(record.potential[c] + w_C * live[c]),
+                "revisit": float(revisit_unit if int(c) in record.recent else 0.0),
                 "K": float(k),
             }
             for c, k in zip(record.choice.candidates, record.choice.scores, strict=True)
@@ -152,6 +164,7 @@ class PotentialFieldGuards(GuardAI):
             "t": record.t,
             "node": record.node,
             "teammates": [int(g) for g in record.teammates],
+            "recent": [int(v) for v in record.recent],
             "weights": {"w_I": w_I, "w_C": w_C, "w_N": w_N},
             "candidates": candidates,
             "winner": record.choice.winner,

@@ -25,8 +25,10 @@ def alarm_bell_block() -> str:
 
 
 def sim(*extra: str, trace: Path) -> dict:
+    # Blind guards in both arms: only the bell can raise the alert, not a lucky sighting.
     command = [sys.executable, "-m", "headless.cli", "sim", "miami", "--guards", "pf",
-               "--scenario", "fixed", "--seed", "3", "--json", "--trace", str(trace), *extra]
+               "--scenario", "fixed", "--seed", "3", "--set", "world.view_range=0",
+               "--json", "--trace", str(trace), *extra]
     result = subprocess.run(command, capture_output=True, text=True, cwd=ROOT, check=False)
     assert result.returncode == 0, result.stderr
     return json.loads(result.stdout)
