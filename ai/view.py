@@ -10,7 +10,7 @@ never touches pymunk and never learns which abstraction it runs on.
 from __future__ import annotations
 
 from abc import ABC, abstractmethod
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -106,6 +106,21 @@ class GuardAI(ABC):
         return self.mode
 
 
+@dataclass(frozen=True)
+class Action:
+    """A player action a scripted policy asks the world for (the keyboard's actions).
+
+    ``kind``: ``"sprint"`` / ``"walk"`` (start / stop sprinting), ``"throw"`` (a decoy
+    aimed at ``target``), ``"activate_decoy"``, ``"take_down"``, ``"toggle_rain"``.
+    """
+
+    kind: str
+    target: tuple[float, float] | None = None
+
+
+PLAYER_ACTIONS = ("sprint", "walk", "throw", "activate_decoy", "take_down", "toggle_rain")
+
+
 class PlayerPolicy(ABC):
     """A scripted player: picks the next node whenever the player reaches its target."""
 
@@ -121,3 +136,7 @@ class PlayerPolicy(ABC):
     @abstractmethod
     def decide(self, view: WorldView) -> int:
         """The player's next target node."""
+
+    def actions(self, view: WorldView) -> Sequence[Action]:
+        """Actions to take at this decision (sprint, throw, ...); none by default."""
+        return ()

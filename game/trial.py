@@ -136,6 +136,7 @@ def run_trial(
         "level": world.level.name,
         "overrides": dict(spec.overrides),
         "config_hash": config.hash(),
+        "config": config.as_dict(),
         "metrics": metrics,
         "visits": world.m.visits.tolist(),
         "attacks": [round(a, 6) for a in world.m.attacks.tolist()],
@@ -153,6 +154,7 @@ def sim_document(row: Mapping[str, Any]) -> dict[str, Any]:
         "scenario": row["scenario"],
         "seed": row["seed"],
         "config_hash": row["config_hash"],
+        "config": row["config"],
         **({"stimuli": list(row["stimuli"])} if row.get("stimuli") else {}),
         "metrics": row["metrics"],
     }

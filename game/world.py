@@ -27,7 +27,7 @@ from ai.stimuli import (
     zone_view_scale,
     zones_from_config,
 )
-from ai.view import Event
+from ai.view import PLAYER_ACTIONS, Action, Event
 from navmesh.graph import NodeGraph, graph_for
 from navmesh.level import Level
 
@@ -455,6 +455,8 @@ class World:
         if self.player_input is None and self.player_policy is not None and self.player.needs_decision:
             view = view or self.view()
             self._plan(self.player, int(self.player_policy.decide(view)))
+            for action in self.player_policy.actions(view):
+                self.perform(action)
 
         for guard in self.guards:
             self._drive(guard, guard.speed)
@@ -613,6 +615,20 @@ class World:
             x, y = self.player.pos
         d2 = np.sum((self.graph.positions[options] - (x, y)) ** 2, axis=1)
         return int(options[np.argmin(d2)])
+
+    def perform(self, action: Action) -> bool | str:
+        """Carry out a scripted player's :class:`~ai.view.Action` (what the keys do in play)."""
+        if action.kind in ("sprint", "walk"):
+            self.sprinting = action.kind == "sprint"
+            return True
+        if action.kind == "throw":
+            if action.target is None:
+                raise ValueError("a throw action needs a target (x, y)")
+            return self.throw_decoy(*action.target)
+        if action.kind in ("activate_decoy", "take_down", "toggle_rain"):
+            return getattr(self, action.kind)()
+        raise ValueError(f"unknown player action {action.kind!r} (choose from "
+                         f"{', '.join(PLAYER_ACTIONS)})")
 
     def throw_decoy(self, x: float, y: float) -> bool | Refused:
         """Throw a decoy towards (x, y): a noise impulse where it lands; 10 s cooldown."""

@@ -82,6 +82,8 @@ class Preset:
     overrides: tuple[tuple[str, Any], ...] = ()
     description: str = ""
     config_hash: str = ""
+    #: every config value the sweep's trials run with (defaults + the preset's [set])
+    config: Mapping[str, Any] = field(default_factory=dict)
 
     @property
     def n_trials(self) -> int:
@@ -309,7 +311,7 @@ def parse_preset(
         name=name, source=src, text=text, levels=tuple(refs), level_names=tuple(names),
         abstractions=tuple(abstractions), guards=tuple(guards), players=tuple(players),
         scenarios=tuple(scenarios), seeds=seeds, root_seed=root_seed, overrides=overrides,
-        description=description, config_hash=config.hash(),
+        description=description, config_hash=config.hash(), config=config.as_dict(),
     )
 
 
@@ -559,6 +561,7 @@ def run_sweep(
             "preset_name": preset.name, "preset_source": preset.source,
             "preset_toml": preset.text, "design": json.dumps(preset.design()),
             "config_hash": preset.config_hash, "total_trials": str(preset.n_trials),
+            "config": json.dumps(dict(preset.config), sort_keys=True),
             "updated_at": now,
         }
         if store.get_meta("created_at") is None:

@@ -79,7 +79,8 @@ def test_sim_json_is_the_only_stdout_and_trace_lines(tmp_path) -> None:
     assert result.returncode == 0, result.stderr
     document = json.loads(result.stdout)
     assert set(document) >= {"level", "abstraction", "guards", "player", "scenario", "seed",
-                             "metrics"}
+                             "metrics", "config_hash", "config"}
+    assert document["config"]["world.duration"] == 5.0  # the trial records what it ran with
     lines = [json.loads(line) for line in trace.read_text().splitlines()]
     assert [line["t"] for line in lines] == [0.0, 1.0, 2.0, 3.0, 4.0, 5.0]
     for line in lines:

@@ -241,3 +241,46 @@ def test_seeds_differ_and_spawns_are_shared_across_modes() -> None:
     nodes = lambda w: [g.node for g in w.guards] + [w.player.node]  # noqa: E731
     assert nodes(a) == nodes(b)  # paired comparison between guard modes
     assert nodes(a) != nodes(c)
+
+
+# ---------------------------------------------------------------------- scripted actions
+class SprintAndThrowPlayer(PlayerPolicy):
+    """Stays put, sprints, and throws one decoy two cells to its left at its first decision."""
+
+    policy = "scripted"
+
+    def reset(self, graph: NodeGraph, rng: np.random.Generator) -> None:
+        self.thrown = False
+
+    def decide(self, view: WorldView) -> int:
+        return view.player_node
+
+    def actions(self, view: WorldView):
+        from ai.view import Action
+
+        if self.thrown:
+            return ()
+        self.thrown = True
+        x, y = view.player_pos
+        return (Action("sprint"), Action("throw", (float(x) - 2.0, float(y))))
+
+
+def test_scripted_policies_can_act_like_the_keyboard() -> None:
+    world = make(corridor_level(), StayGuards(), SprintAndThrowPlayer(), scenario="fixed",
+                 overrides=["world.guards=1"])
+    kinds = []
+    world.on_tick = lambda w: kinds.extend(e.kind for e in w.tick_events)
+    for _ in range(round(1.0 / world.dt) + 1):
+        world.step()
+    assert world.sprinting
+    assert "throw_landed" in kinds
+    landed = next(s for s in world.stimuli.active if getattr(s, "node", -1) >= 0)
+    assert tuple(world.graph.node_cell[landed.node]) == (1, 8)  # two cells left of column 10
+
+
+def test_unknown_action_is_a_clear_error() -> None:
+    from ai.view import Action
+
+    world = make(corridor_level(), StayGuards(), StayPlayer(), overrides=["world.guards=1"])
+    with pytest.raises(ValueError, match="unknown player action 'fly'"):
+        world.perform(Action("fly"))
