@@ -16,7 +16,7 @@ import numpy as np
 
 from navmesh.graph import NodeGraph
 
-from .fields import active_guard_nodes, sighting_node
+from .fields import active_guard_nodes, information_layer, sighting_node
 from .params import FSMParams, StalenessParams
 from .view import GuardAI, WorldView, move_horizon
 
@@ -125,12 +125,7 @@ class ScriptedGuards(GuardAI):
 
     @extra_information.setter
     def extra_information(self, values: np.ndarray) -> None:
-        values = np.array(values, dtype=np.float64)
-        if values.shape != (self.graph.n,):
-            raise ValueError(
-                f"extra_information must have shape ({self.graph.n},), got {values.shape}"
-            )
-        self._extra = values
+        self._extra = information_layer(values, self.graph.n)
 
     # ------------------------------------------------------------------ timers and states
     def tick(self, view: WorldView, dt: float) -> None:

@@ -164,6 +164,14 @@ def sighting_node(view: WorldView) -> int | None:
 # ---------------------------------------------------------------------------- the field
 
 
+def information_layer(values: np.ndarray | Sequence[float], n: int) -> np.ndarray:
+    """A copy of ``values`` as a float (n,) array: what the ``extra_information`` hooks take."""
+    layer = np.array(values, dtype=np.float64)
+    if layer.shape != (n,):
+        raise ValueError(f"extra_information must have shape ({n},), got {layer.shape}")
+    return layer
+
+
 class Choice(NamedTuple):
     """One argmin decision: the winner, the candidates with their K, and the tied ones."""
 
@@ -235,12 +243,7 @@ class CompositeField:
 
     @extra_information.setter
     def extra_information(self, values: np.ndarray) -> None:
-        values = np.array(values, dtype=np.float64)
-        if values.shape != (self.graph.n,):
-            raise ValueError(
-                f"extra_information must have shape ({self.graph.n},), got {values.shape}"
-            )
-        self._extra = _read_only(values)
+        self._extra = _read_only(information_layer(values, self.graph.n))
         self._version += 1
 
     @property

@@ -27,6 +27,7 @@ from game.front.render import (
     GOOD,
     WARN,
     DrawOptions,
+    FrameLoop,
     Renderer,
     default_window_size,
     init_pygame,
@@ -77,7 +78,7 @@ class PlaySettings:
     show_plans: bool = False
 
 
-class PlayGame:
+class PlayGame(FrameLoop):
     """One game window: world, scene builder, renderer and the input handling.
 
     ``lockstep=True`` advances exactly one physics step per :meth:`frame`; otherwise the
@@ -292,16 +293,6 @@ class PlayGame:
         """Give the frozen heap back to the garbage collector (the window stays to the caller)."""
         gc.unfreeze()
 
-    def run(self, frames: int | None = None) -> list[float]:
-        """Loop until Esc / window close (or ``frames`` frames); return each frame's seconds."""
-        times: list[float] = []
-        elapsed = 0.0
-        while self.running and (frames is None or len(times) < frames):
-            start = time.perf_counter()
-            self.frame(elapsed)
-            times.append(time.perf_counter() - start)
-            elapsed = 0.0 if self.lockstep else self.clock.tick(60) / 1000.0
-        return times
 
 
 def _freeze_heap() -> None:

@@ -12,6 +12,8 @@ least K), cold (blue) for positive values, which repel them, neutral grey for 0.
 
 from __future__ import annotations
 
+import time
+
 import os
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
@@ -552,6 +554,33 @@ class Renderer:
         surface.blit(big, ((w - big.get_width()) // 2, y + 12))
         if small:
             surface.blit(small, ((w - small.get_width()) // 2, y + 16 + big.get_height()))
+
+
+class FrameLoop:
+    """The frame loop play and replay share: ``frame(elapsed)`` until Esc or ``frames``.
+
+    Subclasses set ``running``, ``lockstep`` and ``clock`` and implement ``frame``. In
+    lockstep (tests, ``--frames``) every frame advances one fixed step; otherwise the clock
+    paces the loop at 60 frames per second and passes the real elapsed time.
+    """
+
+    running: bool
+    lockstep: bool
+    clock: pygame.time.Clock
+
+    def frame(self, elapsed: float) -> None:  # pragma: no cover - implemented by subclasses
+        raise NotImplementedError
+
+    def run(self, frames: int | None = None) -> list[float]:
+        """Loop until Esc / window close (or ``frames`` frames); return each frame's seconds."""
+        times: list[float] = []
+        elapsed = 0.0
+        while self.running and (frames is None or len(times) < frames):
+            start = time.perf_counter()
+            self.frame(elapsed)
+            times.append(time.perf_counter() - start)
+            elapsed = 0.0 if self.lockstep else self.clock.tick(60) / 1000.0
+        return times
 
 
 def default_window_size(static: StaticScene) -> tuple[int, int]:

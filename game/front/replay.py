@@ -16,7 +16,6 @@ from __future__ import annotations
 import argparse
 import json
 import math
-import time
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -24,7 +23,7 @@ from typing import Any
 
 import numpy as np
 
-from game.front.render import DrawOptions, Renderer, default_window_size, init_pygame, pygame
+from game.front.render import DrawOptions, FrameLoop, Renderer, default_window_size, init_pygame, pygame
 from game.scene import GuardDrawing, PlayerDrawing, Scene, SceneBuilder
 from navmesh.graph import NodeGraph
 from navmesh.level import Level
@@ -336,7 +335,7 @@ class Playback:
 # ---------------------------------------------------------------------------- the window
 
 
-class ReplayViewer:
+class ReplayViewer(FrameLoop):
     """Window that plays a trace: pause, step, speed, mesh and target display."""
 
     def __init__(
@@ -482,16 +481,6 @@ class ReplayViewer:
         self.renderer.draw(self.screen, scene, options)
         pygame.display.flip()
 
-    def run(self, frames: int | None = None) -> list[float]:
-        """Loop until Esc / window close (or ``frames`` frames); return each frame's seconds."""
-        times: list[float] = []
-        elapsed = 0.0
-        while self.running and (frames is None or len(times) < frames):
-            start = time.perf_counter()
-            self.frame(elapsed)
-            times.append(time.perf_counter() - start)
-            elapsed = 0.0 if self.lockstep else self.clock.tick(60) / 1000.0
-        return times
 
 
 # ---------------------------------------------------------------------------- command line
