@@ -63,6 +63,10 @@ class Agent:
     #: position cached once per physics step (reading pymunk's Vec2d costs ~1 µs a time)
     pos: tuple[float, float] = (0.0, 0.0)
     velocity: tuple[float, float] = (0.0, 0.0)
+    #: (waypoint, speed, distance left after this step) while cruising a straight stretch
+    cruise: tuple[tuple[float, float], float, float] | None = None
+    #: whether the last physics step moved the body exactly as commanded (no wall contact)
+    on_track: bool = False
 
     def sync(self) -> None:
         """Read the body's position after a physics step."""
@@ -72,6 +76,7 @@ class Agent:
     def place(self, xy: tuple[float, float]) -> None:
         """Teleport the body (spawn, respawn) and stop it."""
         self.body.position = xy
+        self.cruise = None
         self.set_velocity((0.0, 0.0))
         self.pos = (float(xy[0]), float(xy[1]))
 
@@ -393,21 +398,34 @@ class World:
         return out
 
     def _drive(self, agent: Agent, speed: float) -> None:
-        """Set the body's velocity towards its next waypoint, landing on it exactly."""
+        """Set the body's velocity towards its next waypoint, landing on it exactly.
+
+        On a straight stretch the velocity stays what it was while the body moved exactly
+        as commanded (``agent.cruise``), so most steps do no arithmetic here at all.
+        """
         if not agent.active or not agent.waypoints:
+            agent.cruise = None
             agent.set_velocity((0.0, 0.0))
+            return
+        waypoint = agent.waypoints[0]
+        step = speed * self.dt
+        cruise = agent.cruise
+        if (cruise is not None and cruise[0] is waypoint and cruise[1] == speed
+                and agent.on_track and cruise[2] > step):
+            agent.cruise = (waypoint, speed, cruise[2] - step)
             return
         x, y = agent.pos
-        wx, wy = agent.waypoints[0]
-        dx, dy = wx - x, wy - y
+        dx, dy = waypoint[0] - x, waypoint[1] - y
         d = math.hypot(dx, dy)
         if d < 1e-12:
+            agent.cruise = None
             agent.set_velocity((0.0, 0.0))
             return
-        step = speed * self.dt
         if d <= step:
+            agent.cruise = None
             agent.set_velocity((dx / self.dt, dy / self.dt))
         else:
+            agent.cruise = (waypoint, speed, d - step)
             agent.set_velocity((dx / d * speed, dy / d * speed))
         agent.heading = math.atan2(dy, dx)
 
@@ -488,9 +506,10 @@ class World:
             agent.sync()
             x, y = agent.pos
             moved = math.hypot(x - bx, y - by)
+            agent.on_track = abs(moved - speed * self.dt) < 1e-9
             agent.since_target += self.dt
             self._advance_waypoints(agent, moved, speed * self.dt)
-            node = self.graph.node_at(x, y)
+            node = self.graph.node_near(x, y, agent.node)
             if node != agent.node:
                 self._enter_node(agent, node, count_visit=True)
             if agent.waypoints and agent.since_target > self.stuck_timeout:

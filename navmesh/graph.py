@@ -139,6 +139,12 @@ class NodeGraph:
                 return int(tri)
         return self.nearest_node(x, y)
 
+    def node_near(self, x: float, y: float, hint: int) -> int:
+        """:meth:`node_at` for a walker last seen on node ``hint`` (usually still there)."""
+        if self.mesh is not None and hint >= 0 and self.mesh.triangle_contains(hint, x, y):
+            return hint
+        return self.node_at(x, y)
+
     def nearest_node(self, x: float, y: float) -> int:
         """The node whose position is closest to (x, y) in straight-line distance."""
         d2 = np.sum((self.positions - (x, y)) ** 2, axis=1)
