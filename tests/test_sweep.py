@@ -86,6 +86,11 @@ def test_bundled_presets_expand_to_their_designs() -> None:
     assert len({s.key for s in specs}) == len(specs)
     assert specs == load_preset("paper").specs()  # deterministic order
     assert [s.seed for s in specs[:200]] == [0] * 200  # seeds outermost
+    literal = load_preset("paper-pf-literal")
+    assert literal.n_trials == 2_000 and literal.guards == ("pf",)
+    literal_keys = {s.key.rsplit("/", 1)[0] for s in literal.specs()}
+    paper_pf = {s.key.rsplit("/", 1)[0] for s in specs if s.guards == "pf"}
+    assert literal_keys == paper_pf  # the same trials, only the PF extensions switched off
 
 
 def test_preset_by_path_and_nested_overrides(tmp_path: Path) -> None:
