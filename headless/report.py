@@ -360,8 +360,7 @@ def _heatmap_png(path: Path, level: Any, graph: Any, values: np.ndarray, grid: n
     aspect = height / width if width else 1.0
     fig = Figure(figsize=(7.0, max(3.4, min(9.5, 5.6 * aspect + 1.4))), dpi=110)
     ax = fig.add_subplot()
-    cmap = colormaps[cmap_name].copy()
-    cmap.set_bad(WALL_COLOUR)
+    cmap = colormaps[cmap_name].with_extremes(bad=WALL_COLOUR)
     top = float(np.nanmax(values)) if len(values) else 0.0
     norm = Normalize(vmin=0.0, vmax=top if top > 0 else 1.0)
     image: Any

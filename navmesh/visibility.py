@@ -1,0 +1,701 @@
+"""Exact Euclidean shortest paths in a polygon with holes — two independent implementations.
+
+* :class:`VisibilityGraph` works on the polygon itself: a visibility graph over the reflex
+  corners of the walkable area (the only places a shortest path can bend), all-pairs
+  distances by Floyd–Warshall and numpy-vectorised segment visibility (about R × E segment
+  tests per query).  It is the *oracle* the navmesh paths are measured against (tests,
+  ``benchmarks/navmesh.py``).
+* :class:`MeshSight` works on a triangle mesh and is what
+  :meth:`navmesh.mesh.NavMesh.find_path` uses: corner visibility precomputed per triangle
+  by triangular expansion, so a query costs a few cross products and one small matrix.
+
+Visibility is *closed*: a segment may touch and run along walls, but may not enter an
+obstacle, nor slip through a pinch point where two obstacles touch corner to corner.
+
+>>> from shapely import box
+>>> vg = VisibilityGraph(box(0, 0, 10, 10).difference(box(4, 0, 6, 8)))
+>>> points, length = vg.shortest_path((1, 1), (9, 1))
+>>> points.tolist(), round(length, 6)
+([[1.0, 1.0], [4.0, 8.0], [6.0, 8.0], [9.0, 1.0]], 17.231546)
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import shapely
+from shapely.geometry import Polygon
+from shapely.geometry.polygon import orient
+
+__all__ = ["MeshSight", "VisibilityGraph", "polygon_rings"]
+
+_TWO_PI = 2.0 * math.pi
+_ANGLE_TOL = 1e-9
+
+
+def polygon_rings(polygon: Polygon, tol: float) -> list[np.ndarray]:
+    """Clean rings of ``polygon``: exterior first, walkable side on the left of every edge.
+
+    The exterior is counter-clockwise and holes clockwise in the coordinate sense
+    (positive signed area = ``cross(b - a, c - a) > 0``).  Repeated points are dropped, a
+    vertex of one ring lying on an edge of another (rings touching) is inserted into that
+    edge, and straight pass-through vertices used by a single ring are removed.
+    """
+    if not isinstance(polygon, Polygon):
+        raise TypeError(f"expected a shapely Polygon, got {type(polygon).__name__}")
+    if polygon.is_empty:
+        raise ValueError("polygon is empty")
+    if not polygon.is_valid:
+        raise ValueError(f"polygon is invalid: {shapely.is_valid_reason(polygon)}")
+    if polygon.area <= 0.0:
+        raise ValueError("polygon has zero area")
+    poly = orient(polygon, sign=1.0)
+    rings = [np.asarray(poly.exterior.coords, dtype=np.float64)[:-1, :2]]
+    rings += [np.asarray(r.coords, dtype=np.float64)[:-1, :2] for r in poly.interiors]
+    rings = [_drop_repeats(r, tol) for r in rings]
+    rings = _insert_touching(rings, tol)
+    rings = _drop_straight(rings, tol)
+    return rings
+
+
+def _drop_repeats(ring: np.ndarray, tol: float) -> np.ndarray:
+    nxt = np.roll(ring, -1, axis=0)
+    keep = np.hypot(*(nxt - ring).T) > tol
+    return ring[keep]
+
+
+def _insert_touching(rings: list[np.ndarray], tol: float) -> list[np.ndarray]:
+    """Insert into each edge the vertices of any ring that lie strictly inside it."""
+    allv = np.concatenate(rings)
+    out = []
+    for ring in rings:
+        a, b = ring, np.roll(ring, -1, axis=0)
+        e = b - a
+        le2 = np.einsum("ij,ij->i", e, e)
+        rel = allv[None, :, :] - a[:, None, :]
+        t = np.einsum("ijk,ik->ij", rel, e) / le2[:, None]
+        dist = np.abs(e[:, None, 0] * rel[..., 1] - e[:, None, 1] * rel[..., 0]) / np.sqrt(le2)[:, None]
+        le = np.sqrt(le2)[:, None]
+        on = (dist <= tol) & (t * le > tol) & ((1.0 - t) * le > tol)
+        if not on.any():
+            out.append(ring)
+            continue
+        pts: list[np.ndarray] = []
+        for i in range(len(ring)):
+            pts.append(ring[i : i + 1])
+            idx = np.flatnonzero(on[i])
+            if idx.size:
+                pts.append(allv[idx[np.argsort(t[i, idx])]])
+        out.append(_drop_repeats(np.concatenate(pts), tol))
+    return out
+
+
+def _drop_straight(rings: list[np.ndarray], tol: float) -> list[np.ndarray]:
+    """Remove vertices where a ring goes straight on, unless another ring touches there."""
+    allv = np.concatenate(rings)
+    _, inv, counts = np.unique(allv, axis=0, return_inverse=True, return_counts=True)
+    shared = counts[inv.ravel()] > 1
+    out, start = [], 0
+    for ring in rings:
+        n = len(ring)
+        sh = shared[start : start + n]
+        start += n
+        while True:
+            prv, nxt = np.roll(ring, 1, axis=0), np.roll(ring, -1, axis=0)
+            u, v = ring - prv, nxt - ring
+            cr = u[:, 0] * v[:, 1] - u[:, 1] * v[:, 0]
+            dot = np.einsum("ij,ij->i", u, v)
+            lu, lv = np.hypot(*u.T), np.hypot(*v.T)
+            straight = (np.abs(cr) <= tol * np.maximum(lu, lv)) & (dot > 0) & ~sh
+            if not straight.any() or len(ring) - straight.sum() < 3:
+                break
+            # drop every other straight vertex per pass so neighbours stay valid references
+            idx = np.flatnonzero(straight)
+            drop = idx[np.concatenate(([True], np.diff(idx) > 1))]
+            keep = np.ones(len(ring), bool)
+            keep[drop] = False
+            ring, sh = ring[keep], sh[keep]
+        out.append(ring)
+    return out
+
+
+class VisibilityGraph:
+    """Exact shortest paths in a (closed) polygon with holes.
+
+    Attributes: ``reflex`` (R, 2) positions of the reflex corners (one entry per reflex
+    sector, so a pinch vertex may appear twice), ``dist`` (R, R) geodesic distances
+    between them.
+    """
+
+    def __init__(self, polygon: Polygon, *, tol: float | None = None) -> None:
+        minx, miny, maxx, maxy = polygon.bounds
+        self.tol = tol if tol is not None else 1e-9 * max(1.0, maxx - minx, maxy - miny)
+        rings = polygon_rings(polygon, self.tol)
+        a = np.concatenate(rings)
+        b = np.concatenate([np.roll(r, -1, axis=0) for r in rings])
+        p = np.concatenate([np.roll(r, 1, axis=0) for r in rings])
+        self._ea, self._eb = a, b
+        e = b - a
+        self._elen = np.hypot(*e.T)
+        self._eunit = e / self._elen[:, None]
+        self._build_sectors(a, b, p)
+        self._build_graph()
+
+    # ------------------------------------------------------------------ sectors
+    def _build_sectors(self, w: np.ndarray, nxt: np.ndarray, prv: np.ndarray) -> None:
+        """Walkable angular sectors at every boundary vertex (several at pinch points)."""
+        verts, inv = np.unique(w, axis=0, return_inverse=True)
+        inv = inv.ravel()
+        ang_next = np.arctan2(*(nxt - w)[:, ::-1].T)
+        ang_prev = np.arctan2(*(prv - w)[:, ::-1].T)
+        sec_vert, sec_start, sec_sweep = [], [], []
+        for v in range(len(verts)):
+            occ = np.flatnonzero(inv == v)
+            for i in occ:
+                ccw = (ang_prev[occ] - ang_next[i]) % _TWO_PI
+                ccw[ccw <= _ANGLE_TOL] = _TWO_PI  # a prev ray on the next ray closes nothing
+                sec_vert.append(v)
+                sec_start.append(ang_next[i])
+                sec_sweep.append(ccw.min())
+        order = np.argsort(np.asarray(sec_vert), kind="stable")
+        self._verts = verts
+        self._sec_vert = np.asarray(sec_vert)[order]
+        self._sec_start = np.asarray(sec_start)[order]
+        self._sec_sweep = np.asarray(sec_sweep)[order]
+        # first sector of every vertex, for reduceat
+        self._vert_first = np.searchsorted(self._sec_vert, np.arange(len(verts)))
+        reflex = np.flatnonzero(self._sec_sweep > math.pi + 1e-9)
+        self._reflex_sec = reflex
+        self.reflex = verts[self._sec_vert[reflex]]
+
+    def _in_sector(self, ang: np.ndarray) -> np.ndarray:
+        """(n, S) bool: direction angle ``ang[i]`` lies in closed sector s."""
+        rel = (ang[:, None] - self._sec_start[None, :]) % _TWO_PI
+        return (rel <= self._sec_sweep[None, :] + _ANGLE_TOL) | (rel >= _TWO_PI - _ANGLE_TOL)
+
+    # --------------------------------------------------------------- visibility
+    def visible(
+        self,
+        p: np.ndarray,
+        q: np.ndarray,
+        p_sector: np.ndarray | None = None,
+        q_sector: np.ndarray | None = None,
+    ) -> np.ndarray:
+        """For segments ``p[i] → q[i]`` (arrays (n, 2)): does each stay in the closed walkable area?
+
+        ``p`` (and ``q``) must lie in the walkable area.  ``p_sector[i] >= 0`` says ``p[i]``
+        is the reflex corner ``self.reflex[p_sector[i]]`` approached from inside that
+        sector (matters only at pinch points); -1 means a free point.
+        """
+        p = np.atleast_2d(np.asarray(p, dtype=np.float64))
+        q = np.atleast_2d(np.asarray(q, dtype=np.float64))
+        n = max(len(p), len(q))
+        p, q = np.broadcast_to(p, (n, 2)), np.broadcast_to(q, (n, 2))
+        ps = np.full(n, -1) if p_sector is None else np.broadcast_to(np.asarray(p_sector), (n,))
+        qs = np.full(n, -1) if q_sector is None else np.broadcast_to(np.asarray(q_sector), (n,))
+        chunk = max(1, 400_000 // max(len(self._ea), len(self._sec_vert)))
+        out = np.empty(n, dtype=bool)
+        for i in range(0, n, chunk):
+            sl = slice(i, i + chunk)
+            out[sl] = self._visible_chunk(p[sl], q[sl], ps[sl], qs[sl])
+        return out
+
+    def _visible_chunk(self, p: np.ndarray, q: np.ndarray, ps: np.ndarray, qs: np.ndarray) -> np.ndarray:
+        tol = self.tol
+        d = q - p
+        length = np.hypot(*d.T)
+        ok = length > tol
+        safe_len = np.where(ok, length, 1.0)
+        du = d / safe_len[:, None]
+        a, b, eu = self._ea, self._eb, self._eunit
+        # signed distances of edge ends from the segment's line, and of p, q from the edge's line
+        ra = a[None] - p[:, None]
+        rb = b[None] - p[:, None]
+        sa = du[:, None, 0] * ra[..., 1] - du[:, None, 1] * ra[..., 0]
+        sb = du[:, None, 0] * rb[..., 1] - du[:, None, 1] * rb[..., 0]
+        sp = eu[None, :, 0] * (-ra[..., 1]) - eu[None, :, 1] * (-ra[..., 0])
+        rq = q[:, None] - a[None]
+        sq = eu[None, :, 0] * rq[..., 1] - eu[None, :, 1] * rq[..., 0]
+        blocked = ((sa > tol) & (sb < -tol) | (sa < -tol) & (sb > tol)) & (
+            (sp > tol) & (sq < -tol) | (sp < -tol) & (sq > tol)
+        )
+        # an end point inside an edge (not at its vertices) must leave into the walkable side
+        tp = -(eu[None, :, 0] * ra[..., 0] + eu[None, :, 1] * ra[..., 1])
+        tq = eu[None, :, 0] * rq[..., 0] + eu[None, :, 1] * rq[..., 1]
+        el = self._elen[None]
+        turn = eu[None, :, 0] * du[:, None, 1] - eu[None, :, 1] * du[:, None, 0]
+        p_in_edge = (np.abs(sp) <= tol) & (tp > tol) & (tp < el - tol)
+        q_in_edge = (np.abs(sq) <= tol) & (tq > tol) & (tq < el - tol)
+        blocked |= p_in_edge & (turn < -_ANGLE_TOL)
+        blocked |= q_in_edge & (turn > _ANGLE_TOL)
+        bad = blocked.any(axis=1)
+        # vertices on the segment: the walkable sectors there must let it through
+        rw = self._verts[None] - p[:, None]
+        dist = du[:, None, 0] * rw[..., 1] - du[:, None, 1] * rw[..., 0]
+        along = du[:, None, 0] * rw[..., 0] + du[:, None, 1] * rw[..., 1]
+        on = (np.abs(dist) <= tol) & (along >= -tol) & (along <= safe_len[:, None] + tol)
+        rows = np.flatnonzero(on.any(axis=1) & ~bad)
+        if rows.size:
+            ang = np.arctan2(du[rows, 1], du[rows, 0])
+            in_d = self._in_sector(ang)
+            in_nd = self._in_sector(ang + math.pi)
+            first = self._vert_first
+            ok_mid = np.logical_or.reduceat(in_d & in_nd, first, axis=1)
+            ok_p = np.logical_or.reduceat(in_d, first, axis=1)
+            ok_q = np.logical_or.reduceat(in_nd, first, axis=1)
+            for j, r in enumerate(rows):  # a named reflex sector at an end point overrides "any"
+                if ps[r] >= 0:
+                    s = self._reflex_sec[ps[r]]
+                    ok_p[j, self._sec_vert[s]] = in_d[j, s]
+                if qs[r] >= 0:
+                    s = self._reflex_sec[qs[r]]
+                    ok_q[j, self._sec_vert[s]] = in_nd[j, s]
+            o = on[rows]
+            at_p = o & (np.hypot(rw[rows, :, 0], rw[rows, :, 1]) <= tol)
+            rwq = self._verts[None] - q[rows, None]
+            at_q = o & (np.hypot(rwq[..., 0], rwq[..., 1]) <= tol)
+            mid = o & ~at_p & ~at_q
+            fail = (mid & ~ok_mid) | (at_p & ~ok_p) | (at_q & ~ok_q)
+            bad[rows] |= fail.any(axis=1)
+        return ~bad | ~ok
+
+    # -------------------------------------------------------------------- graph
+    def _build_graph(self) -> None:
+        r = self.reflex
+        n = len(r)
+        dist = np.full((n, n), np.inf)
+        np.fill_diagonal(dist, 0.0)
+        if n > 1:
+            i, j = np.triu_indices(n, k=1)
+            gap = np.hypot(*(r[i] - r[j]).T)
+            far = gap > self.tol  # two sectors of one pinch vertex are not connected
+            i, j, gap = i[far], j[far], gap[far]
+            vis = self.visible(r[i], r[j], i, j)
+            dist[i[vis], j[vis]] = gap[vis]
+            dist[j[vis], i[vis]] = gap[vis]
+        nxt = np.where(np.isfinite(dist), np.arange(n)[None, :], -1)
+        for k in range(n):
+            via = dist[:, k : k + 1] + dist[k : k + 1, :]
+            better = via < dist
+            if better.any():
+                dist = np.where(better, via, dist)
+                nxt = np.where(better, nxt[:, k : k + 1], nxt)
+        self.dist = dist
+        self._next = nxt
+
+    # ------------------------------------------------------------------- query
+    def shortest_path(self, start: tuple[float, float], goal: tuple[float, float]) -> tuple[np.ndarray, float]:
+        """Exact shortest path ``(points (k, 2), length)``; both points must be walkable.
+
+        Returns ``(points, inf)`` with just the two points if no path exists.
+        """
+        s = np.asarray(start, dtype=np.float64)
+        g = np.asarray(goal, dtype=np.float64)
+        if self.visible(s[None], g[None])[0]:
+            return np.array([s, g]), float(np.hypot(*(g - s)))
+        n = len(self.reflex)
+        if n == 0:
+            return np.array([s, g]), math.inf
+        idx = np.arange(n)
+        ds = np.where(self.visible(np.repeat(s[None], n, 0), self.reflex, None, idx), np.hypot(*(self.reflex - s).T), np.inf)
+        dg = np.where(self.visible(np.repeat(g[None], n, 0), self.reflex, None, idx), np.hypot(*(self.reflex - g).T), np.inf)
+        total = ds[:, None] + self.dist + dg[None, :]
+        a, b = (int(i) for i in np.unravel_index(np.argmin(total), total.shape))
+        best = float(total[a, b])
+        if not math.isfinite(best):
+            return np.array([s, g]), math.inf
+        chain: list[int] = [a]
+        while chain[-1] != b:
+            chain.append(int(self._next[chain[-1], b]))
+        pts = np.vstack([s[None], self.reflex[chain], g[None]])
+        return pts, best
+
+    def distance(self, start: tuple[float, float], goal: tuple[float, float]) -> float:
+        """Length of the shortest path between two walkable points."""
+        return self.shortest_path(start, goal)[1]
+
+
+# ============================================================================ mesh-based
+class MeshSight:
+    """Exact shortest paths on a triangle mesh, from tables precomputed per triangle.
+
+    * The *corners* a shortest path can bend at are reflex wall vertices.  A vertex
+      where several walls meet (a pinch) has one corner per walkable sector ("group":
+      the triangles around the vertex connected through non-wall edges).
+    * A triangular expansion from every corner records, for every triangle it reaches,
+      the angular window (right ray, left ray) through which the corner sees into it;
+      a triangle seen in full is stored as "fully visible".  So "which corners does a
+      point see" is a few cross products on the tables of the point's triangle.
+    * The same expansions give the corner visibility graph, and all-pairs corner
+      distances with next hops (scipy's Dijkstra when available, else Floyd–Warshall).
+    * A query: straight line if s sees g (the segment is walked through the mesh),
+      else ``min |s a| + D[a, b] + |b g|`` over the corners a seen from s, b seen from g.
+
+    Built from mesh arrays (``vertices``, counter-clockwise ``triangles``, ``neighbors``);
+    raises ``OverflowError`` when there are more than ``max_nodes`` corners.
+    """
+
+    def __init__(
+        self, vertices: np.ndarray, triangles: np.ndarray, neighbors: np.ndarray, tol: float, *, max_nodes: int = 1500
+    ) -> None:
+        self.tol = tol
+        self._xs: list[float] = vertices[:, 0].tolist()
+        self._ys: list[float] = vertices[:, 1].tolist()
+        self._tri: list[list[int]] = triangles.tolist()
+        self._nb: list[list[int]] = neighbors.tolist()
+        self._build_groups()
+        if len(self.node_vertex) > max_nodes:
+            raise OverflowError(f"{len(self.node_vertex)} corners (more than {max_nodes})")
+        self._expand_all()
+        self._all_pairs()
+
+    # ------------------------------------------------------------------ groups
+    def _build_groups(self) -> None:
+        """Group the (triangle, corner slot) pairs around each vertex into walkable sectors."""
+        tri, nb = self._tri, self._nb
+        n = len(tri)
+        parent = list(range(3 * n))
+
+        def find(i: int) -> int:
+            while parent[i] != i:
+                parent[i] = parent[parent[i]]
+                i = parent[i]
+            return i
+
+        for t in range(n):
+            for k in range(3):
+                u = nb[t][(k + 1) % 3]  # across edge (v[k+2], v[k]): also holds vertex v[k]
+                if u >= 0:
+                    ra, rb = find(3 * t + k), find(3 * u + tri[u].index(tri[t][k]))
+                    if ra != rb:
+                        parent[ra] = rb
+        gid: dict[int, int] = {}
+        group = [gid.setdefault(find(i), len(gid)) for i in range(3 * n)]
+        ng = len(gid)
+        angle = [0.0] * ng
+        walled = [False] * ng  # a group without a wall edge is the full fan of an inner vertex
+        members: list[list[int]] = [[] for _ in range(ng)]
+        vertex = [0] * ng
+        xs, ys = self._xs, self._ys
+        for t in range(n):
+            for k in range(3):
+                w, a, b = tri[t][k], tri[t][(k + 1) % 3], tri[t][(k + 2) % 3]
+                g = group[3 * t + k]
+                angle[g] += _angle_at(xs[w], ys[w], xs[a], ys[a], xs[b], ys[b])
+                members[g].append(t)
+                vertex[g] = w
+                if nb[t][(k + 1) % 3] < 0 or nb[t][(k + 2) % 3] < 0:
+                    walled[g] = True
+        self._slot_group = group  # 3 t + k -> group of vertex v[k] of t
+        self._group_members = members
+        node_of_group = [-1] * ng
+        node_group: list[int] = []
+        for g in range(ng):
+            if walled[g] and angle[g] > math.pi + 1e-9:
+                node_of_group[g] = len(node_group)
+                node_group.append(g)
+        self._node_of_group = node_of_group
+        self._node_group = node_group
+        self.node_vertex = np.asarray([vertex[g] for g in node_group], dtype=np.int64)
+        self.nodes_x = [xs[vertex[g]] for g in node_group]
+        self.nodes_y = [ys[vertex[g]] for g in node_group]
+        self.nodes = np.column_stack([self.nodes_x, self.nodes_y]) if node_group else np.zeros((0, 2))
+
+    # --------------------------------------------------------------- expansion
+    def _expand_all(self) -> None:
+        """Triangular expansion from every corner: visibility windows and corner edges."""
+        n_tri = len(self._tri)
+        fv: list[list[int]] = [[] for _ in range(n_tri)]
+        pv: list[list[tuple]] = [[] for _ in range(n_tri)]
+        edges: dict[tuple[int, int], float] = {}
+        tri, nb, xs, ys = self._tri, self._nb, self._xs, self._ys
+        slot_group, node_of_group = self._slot_group, self._node_of_group
+        hyp, eps = math.hypot, 1e-12
+
+        def node_at(t: int, w: int) -> int:
+            return node_of_group[slot_group[3 * t + tri[t].index(w)]]
+
+        for node, g in enumerate(self._node_group):
+            v = int(self.node_vertex[node])
+            vx, vy = xs[v], ys[v]
+            stack = []
+            for f in self._group_members[g]:
+                k = tri[f].index(v)
+                a, b = tri[f][(k + 1) % 3], tri[f][(k + 2) % 3]
+                fv[f].append(node)
+                for w in (a, b):
+                    other = node_at(f, w)
+                    if other >= 0:
+                        edges[(node, other)] = hyp(xs[w] - vx, ys[w] - vy)
+                u = nb[f][k]
+                if u >= 0:
+                    ax, ay, bx, by = xs[a] - vx, ys[a] - vy, xs[b] - vx, ys[b] - vy
+                    la, lb = hyp(ax, ay), hyp(bx, by)
+                    stack.append((u, a, b, ax / la, ay / la, bx / lb, by / lb, True))
+            while stack:
+                u, p, q, rx, ry, lx, ly, full = stack.pop()
+                tu = tri[u]
+                ip, iq = tu.index(p), tu.index(q)
+                w = tu[3 - ip - iq]
+                wx, wy = xs[w] - vx, ys[w] - vy
+                lw = hyp(wx, wy)
+                wx, wy = wx / lw, wy / lw
+                w_in = rx * wy - ry * wx >= -eps and wx * ly - wy * lx >= -eps
+                if full and w_in:
+                    fv[u].append(node)
+                else:
+                    pv[u].append((node, vx, vy, rx, ry, lx, ly))
+                if w_in:
+                    other = node_at(u, w)
+                    if other >= 0:
+                        edges[(node, other)] = lw
+                # through edge (p, w), opposite q: the left ray may swing in to w
+                l1x, l1y = (wx, wy) if wx * ly - wy * lx > 0 else (lx, ly)
+                if rx * l1y - ry * l1x > eps and nb[u][iq] >= 0:
+                    stack.append((nb[u][iq], p, w, rx, ry, l1x, l1y, full and w_in))
+                # through edge (w, q), opposite p: the right ray may swing in to w
+                r2x, r2y = (wx, wy) if rx * wy - ry * wx > 0 else (rx, ry)
+                if r2x * ly - r2y * lx > eps and nb[u][ip] >= 0:
+                    stack.append((nb[u][ip], w, q, r2x, r2y, lx, ly, full and w_in))
+        self._fv = [np.unique(np.asarray(f, dtype=np.int64)) for f in fv]
+        self._pv: list[tuple[np.ndarray, ...] | None] = []
+        for entries in pv:
+            if entries:
+                arr = np.asarray(entries, dtype=np.float64)
+                self._pv.append((arr[:, 0].astype(np.int64), arr[:, 1], arr[:, 2], arr[:, 3], arr[:, 4], arr[:, 5], arr[:, 6]))
+            else:
+                self._pv.append(None)
+        self._edges = {key: d for key, d in edges.items() if key[0] != key[1]}
+
+    def _all_pairs(self) -> None:
+        """Corner-to-corner geodesic distances and next hops."""
+        n = len(self.node_vertex)
+        w = np.full((n, n), np.inf)
+        for (a, b), d in self._edges.items():
+            w[a, b] = w[b, a] = min(w[a, b], d)
+        try:
+            from scipy.sparse import csr_matrix
+            from scipy.sparse.csgraph import shortest_path
+        except ImportError:  # pragma: no cover - scipy is a project dependency
+            shortest_path = None
+        if shortest_path is not None and n > 0:
+            finite = np.isfinite(w)
+            graph = csr_matrix((w[finite], np.nonzero(finite)), shape=(n, n))
+            dist, pred = shortest_path(graph, method="D", directed=False, return_predecessors=True)
+            # next hop from a towards b = predecessor of a on the tree rooted at b
+            nxt = pred.T.copy()
+            np.fill_diagonal(nxt, np.arange(n))
+        else:
+            dist = w.copy()
+            np.fill_diagonal(dist, 0.0)
+            nxt = np.where(np.isfinite(dist), np.arange(n)[None, :], -1)
+            for k in range(n):
+                via = dist[:, k : k + 1] + dist[k : k + 1, :]
+                better = via < dist
+                if better.any():
+                    dist = np.where(better, via, dist)
+                    nxt = np.where(better, nxt[:, k : k + 1], nxt)
+        self.dist = np.ascontiguousarray(dist)
+        self._next = nxt
+
+    # ----------------------------------------------------------------- queries
+    def visible_nodes(self, t: int, px: float, py: float) -> tuple[np.ndarray, np.ndarray]:
+        """Corner nodes seen from point p in triangle t, and their distances from p."""
+        nodes = self._fv[t]
+        pv = self._pv[t]
+        if pv is not None:
+            ids, vx, vy, rx, ry, lx, ly = pv
+            dx, dy = px - vx, py - vy
+            tol = -self.tol
+            ok = (rx * dy - ry * dx >= tol) & (dx * ly - dy * lx >= tol)
+            if ok.any():
+                nodes = np.concatenate([nodes, ids[ok]])
+        pos = self.nodes[nodes]
+        return nodes, np.hypot(pos[:, 0] - px, pos[:, 1] - py)
+
+    def corner_path(
+        self, ts: list[int], sx: float, sy: float, tg: list[int], gx: float, gy: float
+    ) -> tuple[list[int], float]:
+        """Best corner chain from s to g for an s that does not see g: (nodes, length).
+
+        ``ts`` / ``tg``: triangles holding s / g (several only at a pinch vertex).
+        """
+        a_nodes, a_dist = self._visible_from(ts, sx, sy)
+        b_nodes, b_dist = self._visible_from(tg, gx, gy)
+        if a_nodes.size == 0 or b_nodes.size == 0:
+            return [], math.inf
+        total = self.dist[a_nodes[:, None], b_nodes]
+        total += a_dist[:, None]
+        total += b_dist
+        i = int(np.argmin(total))
+        ia, ib = divmod(i, total.shape[1])
+        best = float(total[ia, ib])
+        a, b = int(a_nodes[ia]), int(b_nodes[ib])
+        chain = [a]
+        nxt = self._next
+        for _ in range(len(self.nodes_x)):
+            if a == b:
+                break
+            a = int(nxt[a, b])
+            chain.append(a)
+        return chain, best
+
+    def _visible_from(self, ts: list[int], px: float, py: float) -> tuple[np.ndarray, np.ndarray]:
+        if len(ts) == 1:
+            return self.visible_nodes(ts[0], px, py)
+        parts = [self.visible_nodes(t, px, py) for t in ts]
+        return np.concatenate([p[0] for p in parts]), np.concatenate([p[1] for p in parts])
+
+    def fan_towards(self, t: int, w: int, dx: float, dy: float) -> int:
+        """Triangle of w's sector (the one holding t) that direction d leaves w into.
+
+        t itself only if nothing else fits; -1 if d points into a wall.
+        """
+        g = self._slot_group[3 * t + self._tri[t].index(w)]
+        xs, ys = self._xs, self._ys
+        wx, wy = xs[w], ys[w]
+        tol = 1e-12 * math.hypot(dx, dy)
+        found = -1
+        for f in self._group_members[g]:
+            tf = self._tri[f]
+            k = tf.index(w)
+            a, b = tf[(k + 1) % 3], tf[(k + 2) % 3]
+            ax, ay = _unit(xs[a] - wx, ys[a] - wy)
+            bx, by = _unit(xs[b] - wx, ys[b] - wy)
+            if ax * dy - ay * dx >= -tol and dx * by - dy * bx >= -tol:
+                if f != t:
+                    return f
+                found = f
+        return found
+
+    def walk(self, t: int, sx: float, sy: float, gx: float, gy: float, trail: list[int] | None = None) -> int:
+        """Follow the segment s→g from s's triangle t: the triangle reached holding g, or -1 if blocked.
+
+        Rays through vertices continue within the vertex's walkable sector, so grazing a
+        corner is allowed but slipping through a pinch point is not.  Visited triangles
+        are appended to ``trail`` if given.
+        """
+        tri, nb, xs, ys = self._tri, self._nb, self._xs, self._ys
+        dx, dy = gx - sx, gy - sy
+        l2 = dx * dx + dy * dy
+        if l2 == 0.0:
+            if trail is not None:
+                trail.append(t)
+            return t
+        tol = self.tol * math.sqrt(l2)
+        etol = self.tol
+        for k in range(3):  # starting on a vertex: start in the triangle the ray leaves into
+            v = tri[t][k]
+            if abs(xs[v] - sx) <= etol and abs(ys[v] - sy) <= etol:
+                t = self.fan_towards(t, v, dx, dy)
+                if t < 0:
+                    return -1
+                break
+        cur = 0.0
+        for _ in range(4 * len(tri) + 8):
+            if trail is not None:
+                trail.append(t)
+            t0, t1, t2 = tt = tri[t]
+            x0, y0, x1, y1, x2, y2 = xs[t0], ys[t0], xs[t1], ys[t1], xs[t2], ys[t2]
+            # is g in t?  (edge functions, tolerance in world units)
+            if (
+                (x2 - x1) * (gy - y1) - (y2 - y1) * (gx - x1) >= -etol * math.hypot(x2 - x1, y2 - y1)
+                and (x0 - x2) * (gy - y2) - (y0 - y2) * (gx - x2) >= -etol * math.hypot(x0 - x2, y0 - y2)
+                and (x1 - x0) * (gy - y0) - (y1 - y0) * (gx - x0) >= -etol * math.hypot(x1 - x0, y1 - y0)
+            ):
+                return t
+            side = []
+            tau = []
+            for vx, vy in ((x0, y0), (x1, y1), (x2, y2)):
+                ex, ey = vx - sx, vy - sy
+                s_ = dx * ey - dy * ex
+                side.append(0.0 if -tol <= s_ <= tol else s_)
+                tau.append((ex * dx + ey * dy) / l2)
+            # leaving through a vertex on the line, ahead of us?
+            best_k, best_tau = -1, math.inf
+            for k in range(3):
+                if side[k] == 0.0 and cur + 1e-12 < tau[k] < best_tau:
+                    best_k, best_tau = k, tau[k]
+            if best_k >= 0:
+                cur = best_tau
+                nxt = self.fan_towards(t, tt[best_k], dx, dy)
+                if nxt < 0 or nxt == t:
+                    return -1
+                t = nxt
+                continue
+            for k in range(3):
+                sp, sq = side[(k + 1) % 3], side[(k + 2) % 3]
+                if sp < 0.0 < sq:
+                    break
+            else:
+                return -1
+            u = nb[t][k]
+            if u < 0:
+                return -1
+            tp, tq = tau[(k + 1) % 3], tau[(k + 2) % 3]
+            cur = max(cur, tp + (tq - tp) * (sp / (sp - sq)))
+            t = u
+        return -1
+
+    def corridor_of(self, ts: list[int], points: list[tuple[float, float]]) -> list[int]:
+        """Triangles a polyline of mutually visible points (wall corners inside) passes through.
+
+        ``ts``: triangles holding the first point (several only at a pinch vertex).
+        """
+        out: list[int] = []
+        (ax, ay), (bx, by) = points[0], points[1]
+        t = next((u for u in ts if self.walk(u, ax, ay, bx, by) >= 0), ts[0])
+        for i in range(len(points) - 1):
+            (ax, ay), (bx, by) = points[i], points[i + 1]
+            if i > 0:  # at a corner: go round it inside its sector to where the next leg starts
+                w = self._vertex_at(t, ax, ay)
+                t_out = self.fan_towards(t, w, bx - ax, by - ay) if w >= 0 else t
+                out += self._around(t, t_out, w)[1:-1]
+                t = t_out
+            trail: list[int] = []
+            end = self.walk(t, ax, ay, bx, by, trail)
+            if end < 0:
+                raise ValueError("polyline leaves the walkable area")
+            for u in trail:
+                if out and out[-1] != u and u not in self._nb[out[-1]]:
+                    # the walk went through a vertex: go round it to stay edge-connected
+                    shared = [v for v in self._tri[u] if v in self._tri[out[-1]]]
+                    out += self._around(out[-1], u, shared[0] if shared else -1)[1:-1]
+                if not out or out[-1] != u:
+                    out.append(u)
+            t = end
+        return out
+
+    def _vertex_at(self, t: int, x: float, y: float) -> int:
+        for v in self._tri[t]:
+            if abs(self._xs[v] - x) <= self.tol and abs(self._ys[v] - y) <= self.tol:
+                return v
+        return -1
+
+    def _around(self, t: int, target: int, w: int) -> list[int]:
+        """Triangles from t to target turning around vertex w without crossing a wall."""
+        if t == target or w < 0:
+            return [t]
+        for turn in (1, 2):  # 1: counter-clockwise (across edge opposite v[k+1]), 2: clockwise
+            path = [t]
+            cur = t
+            for _ in range(len(self._tri)):
+                k = self._tri[cur].index(w)
+                cur = self._nb[cur][(k + turn) % 3]
+                if cur < 0 or cur == t:
+                    break
+                path.append(cur)
+                if cur == target:
+                    return path
+        return [t, target]
+
+
+def _unit(x: float, y: float) -> tuple[float, float]:
+    n = math.hypot(x, y)
+    return (x / n, y / n) if n > 0 else (0.0, 0.0)
+
+
+def _angle_at(wx: float, wy: float, ax: float, ay: float, bx: float, by: float) -> float:
+    ux, uy, vx, vy = ax - wx, ay - wy, bx - wx, by - wy
+    return abs(math.atan2(ux * vy - uy * vx, ux * vx + uy * vy))
