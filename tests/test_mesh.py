@@ -25,6 +25,16 @@ FAST = settings(max_examples=80, deadline=None, suppress_health_check=[HealthChe
 
 
 # ------------------------------------------------------------------ strategies
+def shortest_edge(polygon: Polygon) -> float:
+    """Length of the polygon's shortest exterior edge.
+
+    Random convex hulls can put two vertices 1e-8 apart (angles near 0 and 2π); such
+    near-degenerate rings are out of scope for the 1e-9 path agreement the tests check.
+    """
+    ring = np.asarray(polygon.exterior.coords)
+    return float(np.hypot(*np.diff(ring, axis=0).T).min())
+
+
 @st.composite
 def rect_with_holes(draw: st.DrawFn, axis_aligned: bool = False) -> Polygon:
     """A rectangle with up to 7 non-overlapping holes strictly inside (rectangles, rotated, convex)."""
@@ -51,6 +61,7 @@ def rect_with_holes(draw: st.DrawFn, axis_aligned: bool = False) -> Polygon:
         if (
             isinstance(hole, Polygon)
             and hole.area > 0.05
+            and shortest_edge(hole) > 0.01  # near-duplicate vertices: a degenerate input
             and inner.contains(hole)
             and all(hole.distance(o) > 0.25 for o in holes)
         ):

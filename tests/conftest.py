@@ -1,0 +1,14 @@
+"""Test-suite settings.
+
+Under CI (``CI`` set in the environment) hypothesis runs derandomized: the same examples on
+every run, so a red CI is always reproducible. Local runs keep drawing fresh examples and
+keep exploring; a failure prints the blob to reproduce it.
+"""
+
+import os
+
+from hypothesis import settings
+
+settings.register_profile("ci", derandomize=True, print_blob=True)
+settings.register_profile("dev", print_blob=True)
+settings.load_profile("ci" if os.environ.get("CI") else "dev")
