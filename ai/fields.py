@@ -406,7 +406,9 @@ class CompositeField:
         scale = self.w_C * self.params.revisit_penalty * self.params.C0
         if not len(recent) or not scale:
             return None
-        return scale * np.isin(candidates, np.asarray(recent, dtype=np.intp))
+        # a broadcast compare: np.isin costs ~25 us on these 4-10 element arrays
+        recent_nodes = np.fromiter(recent, dtype=np.intp, count=len(recent))
+        return scale * (candidates[:, None] == recent_nodes).any(axis=1)
 
     def teammate_confidence(self, teammates: Sequence[int] | np.ndarray) -> np.ndarray:
         """C_live (n,): teammates' deposit at their current nodes × teammate_presence."""
