@@ -181,25 +181,29 @@ def test_fixed_time_counts_captures_and_respawns() -> None:
 
 
 # ---------------------------------------------------------------------- walls
-def _check_agents_stay_inside(level_name: str, abstraction: str, interactive: bool) -> None:
+def _check_agents_stay_inside(level_name: str, abstraction: str, interactive: bool,
+                              mode: str, seed: int, seconds: float) -> None:
+    """Every physics step: every agent centre inside the walkable area, no move crosses a wall."""
     level = load_level(level_name)
-    config = Config.defaults()
-    world = World(level, abstraction, make_guard_ai("random"), make_player_policy("evade"),
-                  config=config, scenario="fixed", seed=3, interactive=interactive)
-    steps = round(15.0 / world.dt)
+    world = World(level, abstraction, make_guard_ai(mode), make_player_policy("evade"),
+                  config=Config.defaults(), scenario="fixed", seed=seed, interactive=interactive)
+    steps = round(seconds / world.dt)
     agents = world.guards + [world.player]
     track = np.empty((steps + 1, len(agents), 2))
+    teleported = np.zeros((steps, len(agents)), dtype=bool)
     track[0] = [a.pos for a in agents]
     for k in range(steps):
+        captures = world.m.captures
         world.step()
         track[k + 1] = [a.pos for a in agents]
+        teleported[k, -1] = world.m.captures > captures  # a fixed-time respawn is not a walk
     points = track.reshape(-1, 2)
     inside = shapely.contains_xy(level.walkable.buffer(1e-6), points[:, 0], points[:, 1])
     assert inside.all(), f"{level_name}/{abstraction}: agent centre outside the walkable area"
     starts = track[:-1].reshape(-1, 2)
     ends = track[1:].reshape(-1, 2)
     moves = shapely.linestrings(np.stack([starts, ends], axis=1))
-    moved = np.linalg.norm(ends - starts, axis=1) > 0
+    moved = (np.linalg.norm(ends - starts, axis=1) > 0) & ~teleported.reshape(-1)
     crossing = shapely.intersects(moves[moved], level.walkable.boundary)
     assert not crossing.any(), f"{level_name}/{abstraction}: an agent passed through a wall"
 
@@ -207,13 +211,15 @@ def _check_agents_stay_inside(level_name: str, abstraction: str, interactive: bo
 @pytest.mark.parametrize("abstraction", ["grid", "partition"])
 @pytest.mark.parametrize("level_name", bundled_level_names())
 def test_agents_never_leave_the_walkable_area(level_name: str, abstraction: str) -> None:
-    _check_agents_stay_inside(level_name, abstraction, interactive=False)
+    """Several trials per level at the headless step (1/20 s): wandering and hunting guards."""
+    _check_agents_stay_inside(level_name, abstraction, False, "random", seed=3, seconds=20.0)
+    _check_agents_stay_inside(level_name, abstraction, False, "pf", seed=4, seconds=20.0)
 
 
 @pytest.mark.parametrize("abstraction", ["grid", "partition"])
-def test_agents_never_leave_the_walkable_area_at_60_hz(abstraction: str) -> None:
-    for level_name in ("maze", "tlou"):
-        _check_agents_stay_inside(level_name, abstraction, interactive=True)
+@pytest.mark.parametrize("level_name", bundled_level_names())
+def test_agents_never_leave_the_walkable_area_at_60_hz(level_name: str, abstraction: str) -> None:
+    _check_agents_stay_inside(level_name, abstraction, True, "cheat", seed=5, seconds=10.0)
 
 
 # ---------------------------------------------------------------------- determinism
