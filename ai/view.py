@@ -59,6 +59,41 @@ class WorldView:
     def n_guards(self) -> int:
         return len(self.guard_nodes)
 
+    @classmethod
+    def at_nodes(
+        cls,
+        graph: NodeGraph,
+        guard_nodes: Sequence[int] | np.ndarray,
+        player_node: int,
+        *,
+        t: float = 0.0,
+        active: Sequence[bool] | np.ndarray | None = None,
+        **fields: Any,
+    ) -> WorldView:
+        """A snapshot with every agent standing on a node's centre, headings 0.
+
+        For driving a controller without a world: tests, benchmarks, a designer's notebook.
+
+        >>> import numpy as np
+        >>> from navmesh.graph import NodeGraph
+        >>> graph = NodeGraph.from_grid(np.ones((1, 4), bool), 1.0)
+        >>> WorldView.at_nodes(graph, [0, 1], 3, sighting=3).player_pos.tolist()
+        [3.5, 0.5]
+        """
+        nodes = np.asarray(guard_nodes, dtype=np.int64)
+        return cls(
+            t=t,
+            graph=graph,
+            guard_nodes=nodes,
+            guard_positions=graph.positions[nodes],
+            guard_headings=np.zeros(len(nodes)),
+            player_node=int(player_node),
+            player_pos=graph.positions[player_node],
+            guard_active=np.ones(len(nodes), dtype=bool) if active is None
+            else np.asarray(active, dtype=bool),
+            **fields,
+        )
+
 
 def move_horizon(graph: NodeGraph, factor: float = 2.5) -> float:
     """How far one decision may reach: one cell on the grid, ``factor`` mean edges on a mesh.

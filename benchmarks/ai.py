@@ -33,17 +33,7 @@ from navmesh.graph import NodeGraph  # noqa: E402
 
 
 def _view(graph: NodeGraph, guards: np.ndarray, player: int, sighting: int | None) -> WorldView:
-    return WorldView(
-        t=0.0,
-        graph=graph,
-        guard_nodes=guards,
-        guard_positions=graph.positions[guards],
-        guard_headings=np.zeros(len(guards)),
-        player_node=player,
-        player_pos=graph.positions[player],
-        sighting=sighting,
-        guard_active=np.ones(len(guards), dtype=bool),
-    )
+    return WorldView.at_nodes(graph, guards, player, sighting=sighting)
 
 
 def _median_us(call: Callable[[int], object], repeat: int) -> float:

@@ -474,12 +474,10 @@ class MeshSight:
         w = np.full((n, n), np.inf)
         for (a, b), d in self._edges.items():
             w[a, b] = w[b, a] = min(w[a, b], d)
-        try:
-            from scipy.sparse import csr_matrix
-            from scipy.sparse.csgraph import shortest_path
-        except ImportError:  # pragma: no cover - scipy is a project dependency
-            shortest_path = None
-        if shortest_path is not None and n > 0:
+        from scipy.sparse import csr_matrix  # a project dependency; imported on first use
+        from scipy.sparse.csgraph import shortest_path
+
+        if n > 0:
             finite = np.isfinite(w)
             graph = csr_matrix((w[finite], np.nonzero(finite)), shape=(n, n))
             dist, pred = shortest_path(graph, method="D", directed=False, return_predecessors=True)
@@ -487,15 +485,7 @@ class MeshSight:
             nxt = pred.T.copy()
             np.fill_diagonal(nxt, np.arange(n))
         else:
-            dist = w.copy()
-            np.fill_diagonal(dist, 0.0)
-            nxt = np.where(np.isfinite(dist), np.arange(n)[None, :], -1)
-            for k in range(n):
-                via = dist[:, k : k + 1] + dist[k : k + 1, :]
-                better = via < dist
-                if better.any():
-                    dist = np.where(better, via, dist)
-                    nxt = np.where(better, nxt[:, k : k + 1], nxt)
+            dist, nxt = w.copy(), np.zeros((0, 0), dtype=np.int64)
         self.dist = np.ascontiguousarray(dist)
         self._next = nxt
 

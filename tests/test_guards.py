@@ -32,19 +32,8 @@ def make_view(
     seen_by: Sequence[int] = (),
     sighting: int | None = None,
 ) -> WorldView:
-    nodes = np.array(guards, dtype=np.int64)
-    return WorldView(
-        t=t,
-        graph=graph,
-        guard_nodes=nodes,
-        guard_positions=graph.positions[nodes],
-        guard_headings=np.zeros(len(nodes)),
-        player_node=player,
-        player_pos=graph.positions[player],
-        seen_by=tuple(seen_by),
-        sighting=sighting,
-        guard_active=np.ones(len(nodes), dtype=bool),
-    )
+    return WorldView.at_nodes(graph, guards, player, t=t, seen_by=tuple(seen_by),
+                              sighting=sighting)
 
 
 def simulate(

@@ -18,17 +18,7 @@ POLICIES = ["maxmin", "safetygraph"]
 def make_view(
     graph: NodeGraph, guards: Sequence[int], player: int, active: Sequence[bool] | None = None
 ) -> WorldView:
-    nodes = np.array(guards, dtype=np.int64)
-    return WorldView(
-        t=0.0,
-        graph=graph,
-        guard_nodes=nodes,
-        guard_positions=graph.positions[nodes],
-        guard_headings=np.zeros(len(nodes)),
-        player_node=player,
-        player_pos=graph.positions[player],
-        guard_active=None if active is None else np.array(active, dtype=bool),
-    )
+    return WorldView.at_nodes(graph, guards, player, active=active)
 
 
 def policy(name: str, graph: NodeGraph, seed: int = 0, **params: object) -> PlayerPolicy:

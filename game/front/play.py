@@ -184,12 +184,9 @@ class PlayGame(FrameLoop):
 
     def handle(self, event: pygame.event.Event) -> None:
         """React to one pygame event."""
-        if event.type == pygame.QUIT:
-            self.running = False
-        elif event.type == pygame.VIDEORESIZE:
-            self.screen = pygame.display.get_surface() or self.screen
-            self.renderer.resize(self.screen.get_size())
-        elif event.type == pygame.MOUSEBUTTONDOWN and event.button == 1:
+        if self.handle_window(event):
+            return
+        if event.type == pygame.MOUSEBUTTONDOWN and event.button == 1:
             x, y = self.renderer.to_world(*event.pos)
             static = self.builder.static
             if 0 <= x <= static.width and 0 <= y <= static.height:

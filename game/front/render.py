@@ -567,6 +567,19 @@ class FrameLoop:
     running: bool
     lockstep: bool
     clock: pygame.time.Clock
+    screen: pygame.Surface
+    renderer: Renderer
+
+    def handle_window(self, event: pygame.event.Event) -> bool:
+        """Close and resize events, the same in every window; True when ``event`` was one."""
+        if event.type == pygame.QUIT:
+            self.running = False
+            return True
+        if event.type == pygame.VIDEORESIZE:
+            self.screen = pygame.display.get_surface() or self.screen
+            self.renderer.resize(self.screen.get_size())
+            return True
+        return False
 
     def frame(self, elapsed: float) -> None:  # pragma: no cover - implemented by subclasses
         raise NotImplementedError

@@ -402,12 +402,9 @@ class ReplayViewer(FrameLoop):
 
     def handle(self, event: pygame.event.Event) -> None:
         """React to one pygame event."""
-        if event.type == pygame.QUIT:
-            self.running = False
-        elif event.type == pygame.VIDEORESIZE:
-            self.screen = pygame.display.get_surface() or self.screen
-            self.renderer.resize(self.screen.get_size())
-        elif event.type == pygame.KEYDOWN:
+        if self.handle_window(event):
+            return
+        if event.type == pygame.KEYDOWN:
             key = event.key
             if key == pygame.K_ESCAPE:
                 self.running = False
