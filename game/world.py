@@ -498,6 +498,8 @@ class World:
             self.m.attacks[self.player.node] += self.attackers * self.dt
             if self.damage_steps >= self.lethal_steps:
                 self._captured()
+                if not self.done:  # respawned: a teleport, not a walk (no footsteps, no stall)
+                    before[-1] = self.player.pos
 
         agents = self.guards + [self.player]
         for agent, (bx, by), speed in zip(

@@ -290,3 +290,24 @@ def test_unknown_action_is_a_clear_error() -> None:
     world = make(corridor_level(), StayGuards(), StayPlayer(), overrides=["world.guards=1"])
     with pytest.raises(ValueError, match="unknown player action 'fly'"):
         world.perform(Action("fly"))
+
+
+def test_a_respawn_is_not_a_walk() -> None:
+    """A sprinting player who never walks makes no footsteps, even when respawns move it.
+
+    Corridor of 5 cells with the guard in the middle and attack range over all of it: the
+    player is captured every 3 s and respawns at either end (a blind guard: a tie drawn per
+    respawn).
+    """
+    level = corridor_level(length=5, guards=[[3.5, 1.5]])
+    world = make(level, StayGuards(), StayPlayer(), scenario="fixed",
+                 overrides=["world.guards=1", "world.attack_range=3.5", "world.view_range=0"])
+    world.sprinting = True
+    kinds, spots = [], set()
+    world.on_tick = lambda w: kinds.extend(e.kind for e in w.tick_events)
+    while not world.done:
+        world.step()
+        spots.add(world.player.node)
+    assert world.m.captures == 20
+    assert len(spots) == 2, "respawns used both ends (else the test proves nothing)"
+    assert "sprint" not in kinds
