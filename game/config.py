@@ -66,6 +66,17 @@ def _coerce(key: str, text: Any, like: Any) -> Any:
     return value
 
 
+def parse_overrides(items: Iterable[str]) -> list[tuple[str, str]]:
+    """``["world.view_range=6", ...]`` as ``[("world.view_range", "6"), ...]`` (unchecked)."""
+    pairs = []
+    for item in items:
+        key, sep, value = item.partition("=")
+        if not sep:
+            raise ConfigError(f"--set {item!r}: expected key=value")
+        pairs.append((key.strip(), value.strip()))
+    return pairs
+
+
 class Config:
     """An immutable flat mapping of dotted keys to values.
 
@@ -88,15 +99,7 @@ class Config:
         return cls.defaults().with_overrides(overrides)
 
     def with_overrides(self, overrides: Iterable[str] | Mapping[str, Any]) -> Config:
-        if isinstance(overrides, Mapping):
-            pairs = list(overrides.items())
-        else:
-            pairs = []
-            for item in overrides:
-                key, sep, value = item.partition("=")
-                if not sep:
-                    raise ConfigError(f"--set {item!r}: expected key=value")
-                pairs.append((key.strip(), value.strip()))
+        pairs = list(overrides.items()) if isinstance(overrides, Mapping) else parse_overrides(overrides)
         values = dict(self._values)
         for key, value in pairs:
             if key not in values:

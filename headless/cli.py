@@ -125,14 +125,11 @@ def cmd_path(args: argparse.Namespace) -> int:
 
 # ---------------------------------------------------------------------- sim
 def _overrides(items: Sequence[str]) -> tuple[tuple[str, Any], ...]:
-    from game.config import Config
+    """The ``--set`` pairs, every key and value checked now (one-line ConfigError)."""
+    from game.config import Config, parse_overrides
 
-    Config.load(items)  # validates every key and value now, with a clear message
-    pairs = []
-    for item in items:
-        key, _, value = item.partition("=")
-        pairs.append((key.strip(), value.strip()))
-    return tuple(pairs)
+    Config.load(items)
+    return tuple(parse_overrides(items))
 
 
 def cmd_sim(args: argparse.Namespace) -> int:

@@ -373,6 +373,19 @@ def _point(value: Any, src: str, field: str) -> Point:
     return (_number(value[0], src, f"{field}[0]"), _number(value[1], src, f"{field}[1]"))
 
 
+def _polygons_overlapping(
+    values: Any, region: Polygon, src: str, field: str, problem: str
+) -> list[Polygon]:
+    """Each of ``values`` parsed as a polygon that must overlap ``region`` (else ``problem``)."""
+    parsed = []
+    for i, raw in enumerate(values):
+        polygon = _parse_polygon(raw, src, f"{field}[{i}]")
+        if region.intersection(polygon).area <= _AREA_EPS:
+            _fail(src, f"{field}[{i}]", problem)
+        parsed.append(polygon)
+    return parsed
+
+
 def _parse_polygon(value: Any, src: str, field: str) -> Polygon:
     """A simple polygon from a list of points (closing point optional)."""
     if not isinstance(value, _ARRAY_TYPES):
@@ -526,12 +539,9 @@ def _polygon_geometry(
 
     if not isinstance(obstacles_value, _ARRAY_TYPES):
         _fail(src, "obstacles", f"expected an array of polygons, got {_describe(obstacles_value)}")
-    obstacles = []
-    for i, raw in enumerate(obstacles_value):
-        obstacle = _parse_polygon(raw, src, f"obstacles[{i}]")
-        if outline.intersection(obstacle).area <= _AREA_EPS:
-            _fail(src, f"obstacles[{i}]", "obstacle lies entirely outside the outline")
-        obstacles.append(obstacle)
+    obstacles = _polygons_overlapping(
+        obstacles_value, outline, src, "obstacles", "obstacle lies entirely outside the outline"
+    )
     field = "obstacles" if obstacles else "outline"
     walkable = outline.difference(shapely.unary_union(obstacles)) if obstacles else outline
     if walkable.area <= _AREA_EPS:
@@ -574,13 +584,9 @@ def _parse_zones(value: Any, walkable: Polygon, src: str) -> dict[str, tuple[Pol
             _fail(src, field, f"unknown zone kind (known kinds: {', '.join(ZONE_KINDS)})")
         if not isinstance(polygons, _ARRAY_TYPES):
             _fail(src, field, f"expected an array of polygons, got {_describe(polygons)}")
-        parsed = []
-        for i, raw in enumerate(polygons):
-            polygon = _parse_polygon(raw, src, f"{field}[{i}]")
-            if walkable.intersection(polygon).area <= _AREA_EPS:
-                _fail(src, f"{field}[{i}]", "zone does not overlap the walkable area")
-            parsed.append(polygon)
-        zones[kind] = tuple(parsed)
+        zones[kind] = tuple(_polygons_overlapping(
+            polygons, walkable, src, field, "zone does not overlap the walkable area"
+        ))
     return zones
 
 
