@@ -283,7 +283,7 @@ class World:
         if not active:
             return int(self.spawn_rng.integers(self.graph.n))
         nodes = np.array([g.node for g in active])
-        score = self.graph.dist[nodes].min(axis=0)
+        score = self.graph.nearest_dist(nodes)
         visible = np.zeros(self.graph.n, dtype=bool)
         for guard in active:
             visible |= self._visible_nodes(guard)
@@ -540,7 +540,7 @@ class World:
             if nodes != self._dist_key:  # nodes change a few times a second, steps 20 times
                 self._dist_key = nodes
                 self._dist_now = (
-                    float(self.graph.dist[list(nodes[1:]), nodes[0]].min()) if nodes[1:] else None
+                    self.graph.nearest_dist_to(nodes[1:], nodes[0]) if nodes[1:] else None
                 )
             if self._dist_now is not None:
                 self.m.dist_sum += self._dist_now
