@@ -120,13 +120,15 @@ class MaxMinPlayer(PlayerPolicy):
             else 0.0
         )
         self.closing = step * np.arange(1, c.maxmin_depth + 1)
+        self.reach = c.maxmin_depth * graph.max_edge_length
 
     def decide(self, view: WorldView) -> int:
         node = int(view.player_node)
         guards = active_guard_nodes(view)
         if len(guards) == 0:
             return node
-        nearest = self.graph.nearest_dist(guards)  # (n,) distance to the closest guard
+        # (n,) distance to the closest guard, promised on the nodes the sequences can reach
+        nearest = self.graph.nearest_dist(guards, around=node, reach=self.reach)
         paths = self.sequences.from_node(node)
         along = nearest[paths] - self.closing  # (m, depth)
         score = along.min(axis=1)

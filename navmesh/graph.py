@@ -181,6 +181,8 @@ class NodeGraph:
             self.dense = n <= DENSE_MAX_NODES
         self._rows = RowCache(ROW_CACHE_BYTES)
         self._labels: np.ndarray | None = None
+        self._last_search: tuple[tuple[int, ...], float, np.ndarray] | None = None
+        self._last_bound: tuple[tuple[tuple[int, ...], int], float] | None = None
         if self.dense:
             hop_matrix = shortest_path(self.adjacency, method="D", unweighted=True)
             self._hops = _as_hops(hop_matrix)
@@ -347,7 +349,7 @@ class NodeGraph:
             row = self._dist[s]
             out = np.where(row <= limit, row, np.inf)
         else:
-            out = dijkstra(self.adjacency, directed=False, indices=s, limit=float(limit))
+            out = dijkstra(self.adjacency, indices=s, limit=float(limit))  # symmetric: no transpose
         out.flags.writeable = False
         return out
 
@@ -363,11 +365,21 @@ class NodeGraph:
             out[mask] = self.dist_from(int(s))[b_arr[mask]]
         return float(out) if out.ndim == 0 else out
 
-    def nearest_dist(self, srcs: Sequence[int] | np.ndarray, limit: float | None = None) -> np.ndarray:
+    def nearest_dist(
+        self,
+        srcs: Sequence[int] | np.ndarray,
+        limit: float | None = None,
+        around: int | None = None,
+        reach: float = 0.0,
+    ) -> np.ndarray:
         """(n,) ``min_s d(s, ·)`` over the sources (one multi-source search on a large graph).
 
         Equal to ``dist_from(srcs).min(axis=0)`` bit for bit: each node's value is the least
-        rounded path sum from any source either way. ``inf`` with no source.
+        rounded path sum from any source either way (a search stopped at a limit leaves the
+        values inside it unchanged). ``inf`` with no source. With ``around``, only the nodes
+        within metric distance ``reach`` of node ``around`` are promised (others may be
+        ``inf``): a large graph then searches no farther than the nearest source's distance
+        to ``around`` plus ``reach``.
         """
         nodes = np.asarray(srcs, dtype=np.intp).ravel()
         if not len(nodes):
@@ -377,38 +389,66 @@ class NodeGraph:
             if limit is not None:
                 found = np.where(found <= limit, found, np.inf)
             return found
+        if around is not None and limit is None:
+            key = tuple(sorted(set(nodes.tolist())))
+            bound = self._reverse_bound(nodes, int(around), key)
+            if not np.isfinite(bound):
+                return np.full(self.n, np.inf)
+            needed = (bound + reach) * (1 + 1e-9) + 1e-9
+            last = self._last_search
+            if last is not None and last[0] == key and last[1] >= needed:
+                return last[2]  # a wider search from the same sources: same values inside
+            row = self._multi_source(nodes, needed)
+            row.flags.writeable = False
+            self._last_search = (key, needed, row)
+            return row
         if len(nodes) == 1 and limit is None:
             return self.dist_from(int(nodes[0]))
         key = ("nearest", tuple(sorted(set(nodes.tolist()))), limit)
-        (row,) = self._rows.get(
-            key,
-            lambda: (dijkstra(self.adjacency, directed=False, indices=nodes, min_only=True,
-                              limit=np.inf if limit is None else float(limit)),),
-        )
+        (row,) = self._rows.get(key, lambda: (self._multi_source(nodes, limit),))
         return row
 
-    def nearest_dist_to(self, srcs: Sequence[int] | np.ndarray, target: int) -> float:
-        """``min_s d(s, target)``: :meth:`nearest_dist` at one node, searching only as far as needed.
+    def _multi_source(self, nodes: np.ndarray, limit: float | None) -> np.ndarray:
+        # The adjacency is symmetric, so the directed search gives the undirected distances
+        # without scipy transposing the matrix on every call.
+        return dijkstra(self.adjacency, indices=nodes, min_only=True,
+                        limit=np.inf if limit is None else float(limit))
 
-        A large graph grows a limited search until it reaches ``target`` (a straight line
-        is a lower bound on a path, so the first limit is already close).
+    def _reverse_bound(self, nodes: np.ndarray, target: int, key: tuple[int, ...]) -> float:
+        """``min_s d(target, s)`` by a search from ``target`` grown until it meets a source.
+
+        Summed from the target's side, so it may differ from ``d(s, target)`` in the last
+        bit: callers use it only as a (padded) search limit. A straight line is a lower
+        bound on a path, so the first limit is already close.
         """
+        if self._last_bound is not None and self._last_bound[0] == (key, target):
+            return self._last_bound[1]
+        bound = self._grow_reverse(nodes, target)
+        self._last_bound = ((key, target), bound)
+        return bound
+
+    def _grow_reverse(self, nodes: np.ndarray, target: int) -> float:
+        gap = float(np.linalg.norm(self.positions[nodes] - self.positions[target], axis=1).min())
+        limit = 1.25 * gap + 2.0 * self.max_edge_length
+        reached = -1
+        while True:
+            row = dijkstra(self.adjacency, indices=target, limit=limit)
+            found = row[nodes].min()
+            if np.isfinite(found):
+                return float(found)
+            count = int(np.isfinite(row).sum())
+            if count == reached:  # the search stopped growing: no source in this piece
+                return np.inf
+            reached, limit = count, 2.0 * limit
+
+    def nearest_dist_to(self, srcs: Sequence[int] | np.ndarray, target: int) -> float:
+        """``min_s d(s, target)``: :meth:`nearest_dist` at one node, searching only as far as needed."""
         nodes = np.asarray(srcs, dtype=np.intp).ravel()
         if not len(nodes):
             return np.inf
         if self.dense:
             return float(self._dist[nodes, target].min())
-        gap = np.linalg.norm(self.positions[nodes] - self.positions[target], axis=1).min()
-        limit = 1.25 * float(gap) + 2.0 * self.max_edge_length
-        reached = -1
-        while True:
-            row = dijkstra(self.adjacency, directed=False, indices=nodes, min_only=True, limit=limit)
-            if np.isfinite(row[target]):
-                return float(row[target])
-            count = int(np.isfinite(row).sum())
-            if count == reached:  # the search stopped growing: target is in another piece
-                return np.inf
-            reached, limit = count, 2.0 * limit
+        return float(self.nearest_dist(nodes, around=target)[target])
 
     def components(self) -> np.ndarray:
         """(n,) label of every node's connected piece."""

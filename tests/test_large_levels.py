@@ -1,0 +1,55 @@
+"""Large levels: a generated 300×300 building runs a full trial; graph storage never
+changes a trial (the same trials with every graph forced to per-source searches)."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import navmesh.graph as graph_module
+from game.trial import TrialSpec, run_trial
+from navmesh.buildings import building_level, building_occupancy
+from navmesh.graph import build_graph
+from navmesh.level import parse_level
+
+
+def test_generated_buildings_are_valid_levels_of_rooms() -> None:
+    for form in ("grid", "polygon"):
+        level = parse_level(building_level(60, 80, seed=2, form=form))
+        assert level.occupancy.shape == (60, 80)
+    occupancy = building_occupancy(60, 80, seed=2)
+    assert 0.5 < occupancy.mean() < 0.95  # walls and furniture, not an open field
+    assert np.array_equal(occupancy, building_occupancy(60, 80, seed=2))
+
+
+def test_a_300x300_building_runs_a_full_trial(tmp_path: Path) -> None:
+    path = tmp_path / "building.json"
+    path.write_text(json.dumps(building_level(300, 300, seed=0)))
+    graph = build_graph(parse_level(json.loads(path.read_text())), "grid")
+    assert graph.n > 50_000 and not graph.dense
+    row = run_trial(TrialSpec(level=str(path), guards="pf", player="maxmin"))
+    assert row["level"] == "building-300x300-0"
+    assert row["coverage"] > 0 and row["avg_guard_player_dist"] > 0
+
+
+@pytest.mark.parametrize("guards,player", [("pf", "maxmin"), ("cheat", "safetygraph"),
+                                           ("staleness", "maxmin"), ("fsm", "safetygraph")])
+def test_trials_do_not_depend_on_the_graph_storage(
+    guards: str, player: str, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    specs = [TrialSpec(level=name, abstraction=ab, guards=guards, player=player, seed=1)
+             for name, ab in (("maze", "grid"), ("tlou", "partition"))]
+    dense = [run_trial(spec) for spec in specs]
+    monkeypatch.setattr(graph_module, "DENSE_MAX_NODES", 0)
+    graph_module.clear_graph_cache()
+    try:
+        searched = [run_trial(spec) for spec in specs]
+    finally:
+        monkeypatch.undo()
+        graph_module.clear_graph_cache()
+    for a, b in zip(dense, searched, strict=True):
+        a.pop("wall_time"), b.pop("wall_time")
+        assert a == b
