@@ -287,11 +287,12 @@ class _Match:
             self.guards.actions[:] = guard_actions
         hp0, t0, caps0 = w.hp, w.t, w.metrics()["captures"]
         staying = False
+        hp = hp0
         for k in range(self.max_steps):
             w.step()
-            captures = w.metrics()["captures"]
-            if w.done or captures > caps0:
+            if w.done or w.hp > hp:  # over, or respawned after a capture (fixed-time)
                 break
+            hp = w.hp
             if self.player.decisions == 1 and k == 0:
                 staying = self.player.target == w.player.node and self._at(self.player.target)
             if self.player.decisions:
