@@ -183,3 +183,15 @@ def test_bad_options_are_clear() -> None:
         StealthEnv("maze", render_mode="ascii")
     with pytest.raises(ValueError, match="unknown config key"):
         StealthEnv("maze", world__gards=2)
+
+
+def test_fixed_time_capture_respawns_and_counts_the_penalty() -> None:
+    env = StealthEnv("maze", guards="cheat", scenario="fixed", world__duration=20.0)
+    env.reset(seed=0)
+    total, term, trunc, info = 0.0, False, False, {}
+    while not (term or trunc):
+        _, r, term, trunc, info = env.step(0)
+        total += r
+    assert not term and trunc and info["captures"] >= 1 and math.isclose(info["t"], 20.0)
+    lost = 3.0 * info["captures"] + (3.0 - info["hp"])
+    assert math.isclose(total, 0.1 * 20.0 - lost - 10.0 * info["captures"], abs_tol=1e-6)
