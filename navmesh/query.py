@@ -113,7 +113,8 @@ class PathQuery:
         if not self._sight_tried:
             self._sight_tried = True
             try:
-                self._sight = MeshSight(self.mesh.vertices, self.mesh.triangles, self.mesh.neighbors, self._tol, max_nodes=MAX_CORNERS)
+                m = self.mesh
+                self._sight = MeshSight(m.vertices, m.triangles, m.neighbors, self._tol, max_nodes=MAX_CORNERS)
             except OverflowError:
                 self._sight = None
         return self._sight

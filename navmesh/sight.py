@@ -28,7 +28,7 @@ class MeshSight:
       a triangle seen in full is stored as "fully visible".  So "which corners does a
       point see" is a few cross products on the tables of the point's triangle.
     * The same expansions give the corner visibility graph, and all-pairs corner
-      distances with next hops (scipy's Dijkstra when available, else Floyd–Warshall).
+      distances with next hops (scipy's Dijkstra).
     * A query: straight line if s sees g (the segment is walked through the mesh),
       else ``min |s a| + D[a, b] + |b g|`` over the corners a seen from s, b seen from g.
 
