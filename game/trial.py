@@ -13,14 +13,13 @@ import time
 import zlib
 from collections.abc import Mapping, Sequence
 from dataclasses import asdict, dataclass
-from functools import lru_cache
 from typing import IO, Any
 
 import numpy as np
 
 from ai import make_guard_ai, make_player_policy
 from ai.stimuli import load_stimulus
-from navmesh.level import Level, load_level
+from navmesh.level import cached_level
 
 from .config import Config
 from .world import World
@@ -75,15 +74,10 @@ def trial_rngs(spec: TrialSpec, level_name: str) -> tuple[np.random.Generator, .
     return tuple(np.random.Generator(np.random.PCG64(s)) for s in seqs)
 
 
-@lru_cache(maxsize=16)
-def _cached_level(name: str) -> Level:
-    return load_level(name)
-
-
 def make_world(spec: TrialSpec, config: Config | None = None, **world_kwargs: Any) -> World:
     """Build the world of a trial (level and graph are cached per process)."""
     config = config or Config.load(dict(spec.overrides))
-    level = _cached_level(spec.level)
+    level = cached_level(spec.level)
     if spec.stimuli:
         world_kwargs.setdefault("stimuli", [load_stimulus(s) for s in spec.stimuli])
     return World(

@@ -35,7 +35,6 @@ import sys
 import time
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
-from functools import lru_cache
 from pathlib import Path
 from typing import Any
 
@@ -48,7 +47,7 @@ from game.config import Config
 from game.trial import TrialSpec, trial_rngs
 from game.world import World
 from navmesh.graph import NodeGraph
-from navmesh.level import Level, load_level
+from navmesh.level import cached_level, load_level
 
 #: guards cannot see and the player cannot be hurt: only the mechanic informs the guards
 BLIND = {"world.view_range": 0.0, "world.attack_range": 0.0, "world.player_hp": 1.0e6}
@@ -77,11 +76,6 @@ class WanderPlayer(PlayerPolicy):
         return options[int(self.rng.integers(len(options)))]
 
 
-@lru_cache(maxsize=8)
-def _level(name: str) -> Level:
-    return load_level(name)
-
-
 def make_world(
     level: str, abstraction: str, seed: int, overrides: Mapping[str, Any], *,
     player: PlayerPolicy | None = None, tag: str = "mechanics",
@@ -89,7 +83,7 @@ def make_world(
     """A PF world of the ``fixed`` scenario whose generators depend on (level, seed, tag) only."""
     config = Config.load({k: str(v).lower() if isinstance(v, bool) else str(v)
                           for k, v in overrides.items()})
-    lvl = _level(level)
+    lvl = cached_level(level)
     spec = TrialSpec(level, abstraction, "pf", tag, "fixed", seed)
     return World(lvl, abstraction, make_guard_ai("pf", config.section("pf")), player,
                  config=config, scenario="fixed", rngs=trial_rngs(spec, lvl.name))

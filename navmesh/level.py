@@ -19,10 +19,11 @@ Every problem with a file is reported as a :class:`LevelError` whose message is 
 
 from __future__ import annotations
 
+import hashlib
 import json
 import math
-from dataclasses import dataclass
-from functools import cached_property
+from dataclasses import dataclass, field
+from functools import cached_property, lru_cache
 from pathlib import Path
 from typing import Any, NoReturn
 
@@ -41,6 +42,7 @@ __all__ = [
     "Level",
     "LevelError",
     "bundled_level_names",
+    "cached_level",
     "load_level",
     "parse_level",
     "resolve_level_path",
@@ -97,7 +99,9 @@ class Level:
     collinear vertices; its exterior is counter-clockwise in world coordinates
     (``exterior.is_ccw``; clockwise on a y-down screen) and its holes the other way.
     ``eq=False``: levels compare and hash by identity (numpy and shapely fields have no
-    useful ``==``).
+    useful ``==``); ``digest`` is the content identity instead: the SHA-256 of the file
+    bytes the level was parsed from (``None`` for a level built in memory), the key of the
+    per-process caches (:func:`cached_level`, :func:`navmesh.graph.graph_for`).
     """
 
     name: str
@@ -108,6 +112,7 @@ class Level:
     zones: dict[str, tuple[Polygon, ...]]
     guards: tuple[Point, ...]
     decoys: tuple[Point, ...]
+    digest: str | None = None
 
     def __post_init__(self) -> None:
         occupancy = np.array(self.occupancy, dtype=bool)  # private copy, then frozen
@@ -195,20 +200,32 @@ def resolve_level_path(path_or_name: str | Path) -> Path:
 
 
 def load_level(path_or_name: str | Path) -> Level:
-    """Load and validate a level from a JSON file or a bundled level name.
+    """Load and validate a level from a JSON file or a bundled level name (parsed afresh).
 
     Errors name the file as the caller gave it (a bundled level by its file name).
     """
-    path = resolve_level_path(path_or_name)
-    source = str(path_or_name) if path == Path(path_or_name) else path.name
-    data = _read_json(path, source)
-    return parse_level(data, source, path=path)
+    content = _read_level_file(path_or_name)
+    return _parse_content(content)
 
 
-def parse_level(data: Any, source: str = "<memory>", *, path: Path | None = None) -> Level:
+def cached_level(path_or_name: str | Path) -> Level:
+    """:func:`load_level`, memoised per process on the file's resolved path and content.
+
+    The one level cache of the project: the file is read on every call (levels are a few
+    kB) and its SHA-256 compared, so an edited file is parsed again — never a stale level —
+    while repeated trials on an unchanged file share one :class:`Level` (and, through
+    ``Level.digest``, one node graph).
+    """
+    return _cached_parse(_read_level_file(path_or_name))
+
+
+def parse_level(
+    data: Any, source: str = "<memory>", *, path: Path | None = None, digest: str | None = None
+) -> Level:
     """Validate an in-memory level (the decoded JSON object) and build its :class:`Level`.
 
-    ``source`` names the level in error messages; ``path`` is stored on the result.
+    ``source`` names the level in error messages; ``path`` and ``digest`` (the content
+    identity of the file it came from) are stored on the result.
     """
     src = source
     if not isinstance(data, dict):
@@ -260,16 +277,43 @@ def parse_level(data: Any, source: str = "<memory>", *, path: Path | None = None
         zones=zones,
         guards=guards,
         decoys=decoys,
+        digest=digest,
     )
 
 
 # --------------------------------------------------------------------------- reading
 
 
-def _read_json(path: Path, src: str) -> Any:
-    """Read and decode a level file; every failure becomes a one-line LevelError."""
+@dataclass(frozen=True)
+class _LevelFile:
+    """A level file's bytes; equal (and hashed) by resolved path and SHA-256 of the bytes only."""
+
+    resolved: str
+    digest: str
+    raw: bytes = field(compare=False, repr=False)
+    path: Path = field(compare=False)
+    source: str = field(compare=False)
+
+
+def _read_level_file(path_or_name: str | Path) -> _LevelFile:
+    path = resolve_level_path(path_or_name)
+    source = str(path_or_name) if path == Path(path_or_name) else path.name
+    raw = _read_bytes(path, source)
+    return _LevelFile(str(path.resolve()), hashlib.sha256(raw).hexdigest(), raw, path, source)
+
+
+def _parse_content(content: _LevelFile) -> Level:
+    data = _decode_json(content.raw, content.source)
+    return parse_level(data, content.source, path=content.path, digest=content.digest)
+
+
+_cached_parse = lru_cache(maxsize=32)(_parse_content)
+
+
+def _read_bytes(path: Path, src: str) -> bytes:
+    """Read a level file; every failure becomes a one-line LevelError."""
     try:
-        raw = path.read_bytes()
+        return path.read_bytes()
     except FileNotFoundError:
         _fail(src, "file", "no such file")
     except IsADirectoryError:
@@ -278,6 +322,10 @@ def _read_json(path: Path, src: str) -> Any:
         _fail(src, "file", "permission denied")
     except OSError as exc:
         _fail(src, "file", f"cannot read ({exc.strerror or exc})")
+
+
+def _decode_json(raw: bytes, src: str) -> Any:
+    """Decode a level file's bytes; every failure becomes a one-line LevelError."""
     if not raw.strip():
         _fail(src, "file", "is empty")
     try:
