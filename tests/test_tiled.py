@@ -460,3 +460,17 @@ def test_walls_cells_of_a_polygon_outline_are_kept_only_where_they_touch_it(tmp_
     level = load_level(path)
     assert level.walkable.symmetric_difference(Polygon([(2, 2), (6, 2), (2, 6)])).area < 1e-9
     assert shapely.equals(level.walkable, Polygon([(2, 2), (6, 2), (2, 6)]))
+
+
+def test_object_templates_in_json_are_read(tmp_path):
+    """An instance of a ``.tj`` template carries only its id, position and overrides."""
+    (tmp_path / "guard.tj").write_text(json.dumps({"object": {
+        "height": 0, "name": "sentry", "point": True, "rotation": 0, "type": "guard",
+        "visible": True, "width": 0}, "type": "template"}))
+    w = MapWriter()
+    objects = [{"id": 7, "template": "guard.tj", "x": 17.5 * T, "y": 1.5 * T},
+               {"id": 8, "template": "guard.tj", "x": 9.5 * T, "y": 9.5 * T},
+               {"id": 9, "template": "guard.tj", "x": 1.5 * T, "y": 17.5 * T}]
+    layers = [w.tiles("walls", grid_gids(MAZE["grid"])), w.objects("o", objects)]
+    path = write(tmp_path, w.map(20, 20, layers))
+    assert_same_level(load_level(path), parse_level({**MAZE, "zones": {}, "decoys": []}))
