@@ -25,7 +25,6 @@ from __future__ import annotations
 import math
 import os
 from collections.abc import Mapping
-from functools import lru_cache
 from typing import Any
 
 import numpy as np
@@ -46,7 +45,7 @@ from ai import make_guard_ai
 from ai.pf import PotentialFieldGuards
 from ai.view import PlayerPolicy, WorldView
 from navmesh.graph import NodeGraph, graph_for
-from navmesh.level import Level, load_level
+from navmesh.level import Level, cached_level
 
 from .config import Config
 from .trial import TrialSpec, trial_rngs
@@ -165,11 +164,6 @@ class ExternalGuards(PotentialFieldGuards):
 # ---------------------------------------------------------------------------- the match
 
 
-@lru_cache(maxsize=16)
-def _level(name: str) -> Level:
-    return load_level(name)
-
-
 def _split_options(level: str, abstraction: str, scenario: str, kwargs: dict[str, Any]
                    ) -> tuple[dict[str, Any], dict[str, Any]]:
     """Env options and config overrides (``world__guards=2`` means ``world.guards=2``)."""
@@ -198,7 +192,7 @@ class _Match:
         unknown = set(rewards or {}) - set(REWARDS)
         if unknown:
             raise ValueError(f"unknown reward terms {sorted(unknown)} (choose from {list(REWARDS)})")
-        self.level = _level(level)
+        self.level = cached_level(level)
         self.abstraction, self.scenario, self.guard_mode = abstraction, scenario, guard_mode
         self.overrides = dict(overrides)
         self.config = Config.load(self.overrides)
