@@ -45,7 +45,7 @@ from ai import make_guard_ai
 from ai.pf import PotentialFieldGuards
 from ai.view import PlayerPolicy, WorldView
 from navmesh.graph import NodeGraph, graph_for
-from navmesh.level import Level, cached_level
+from navmesh.level import cached_level
 
 from .config import Config
 from .trial import TrialSpec, trial_rngs
