@@ -8,7 +8,6 @@ same spec gives bit-identical metrics in any process and any order.
 
 from __future__ import annotations
 
-import json
 import time
 import zlib
 from collections.abc import Mapping, Sequence
@@ -23,6 +22,7 @@ from ai.stimuli import load_stimulus
 from navmesh.level import Level, load_level
 
 from .config import Config
+from .trace import attach_trace
 from .world import World
 
 
@@ -120,15 +120,7 @@ def run_trial(
     started = time.perf_counter()
     world = make_world(spec, config)
     if trace is not None:
-
-        def write(w: World) -> None:
-            record = w.trace_record()
-            if explain:
-                record["explain"] = w.guard_ai.explain(0)
-            trace.write(json.dumps(record) + "\n")
-
-        write(world)
-        world.on_tick = write
+        attach_trace(world, trace, explain=explain)
     metrics = world.run()
     return {
         **{k: v for k, v in asdict(spec).items() if k not in ("overrides", "stimuli")},
