@@ -225,6 +225,12 @@ class PlayerActions:
     stays where scripts and the front end look for it). Each returns True when it
     happened, else a :class:`Refused` message."""
 
+    #: set by :meth:`init_actions`
+    decoy_points: list[tuple[float, float]]
+    decoy_nodes: list[int]
+    next_throw: float
+    rain_on: bool
+
     def _world(self) -> World:
         return cast("World", self)
 

@@ -23,7 +23,7 @@ from navmesh.level import Level, load_level
 
 from .config import Config
 from .trace import attach_trace
-from .world import World
+from .world import Generators, World
 
 
 def _tag(name: str) -> int:
@@ -57,7 +57,7 @@ class TrialSpec:
         return "/".join(parts)
 
 
-def trial_rngs(spec: TrialSpec, level_name: str) -> tuple[np.random.Generator, ...]:
+def trial_rngs(spec: TrialSpec, level_name: str) -> Generators:
     """Generators for spawns, guards and player, derived from the trial's identity.
 
     The spawn generator depends on (root, level, abstraction, seed) only, so every guard
@@ -72,7 +72,8 @@ def trial_rngs(spec: TrialSpec, level_name: str) -> tuple[np.random.Generator, .
         np.random.SeedSequence(base + who + [_tag("guards")]),
         np.random.SeedSequence(base + who + [_tag("player")]),
     ]
-    return tuple(np.random.Generator(np.random.PCG64(s)) for s in seqs)
+    spawn, guards, player = (np.random.Generator(np.random.PCG64(s)) for s in seqs)
+    return spawn, guards, player
 
 
 @lru_cache(maxsize=16)

@@ -28,6 +28,7 @@ from .spawns import guard_spawn_nodes, start_node
 from .zones import ZoneMap
 
 SCENARIOS = ("capture", "fixed")
+Generators = tuple[np.random.Generator, np.random.Generator, np.random.Generator]
 __all__ = ["Agent", "RANGE_EPS", "Refused", "SCENARIOS", "World", "default_rngs"]
 
 
@@ -39,7 +40,7 @@ class World(PlayerActions):
         self, level: Level, abstraction: str, guard_ai: GuardAI,
         player_policy: PlayerPolicy | None, *, config: Config, scenario: str = "capture",
         seed: int = 0,
-        rngs: tuple[np.random.Generator, np.random.Generator, np.random.Generator] | None = None,
+        rngs: Generators | None = None,
         interactive: bool = False, graph: NodeGraph | None = None,
         stimuli: Sequence[StimulusFactory] = (),
     ) -> None:
@@ -47,7 +48,7 @@ class World(PlayerActions):
             raise ValueError(f"unknown scenario {scenario!r} (choose capture or fixed)")
         self.level, self.abstraction, self.scenario = level, abstraction, scenario
         self.config = config
-        self.graph = graph if graph is not None else graph_for(level, abstraction)
+        self.graph: NodeGraph = graph if graph is not None else graph_for(level, abstraction)
         self.guard_ai, self.player_policy = guard_ai, player_policy
         spawn_rng, guard_rng, player_rng = rngs or default_rngs(seed)
         self.spawn_rng = spawn_rng
@@ -89,7 +90,7 @@ class World(PlayerActions):
         self._sprinted = False
         self.player_input: tuple[float, float] | None = None
         self.on_tick: Callable[[World], None] | None = None
-        self.m = Counters.for_nodes(self.graph.n)
+        self.m: Counters = Counters.for_nodes(self.graph.n)
 
         guard_speed = float(w["guard_speed"])
         player_speed = float(w["player_speed"]) * float(s["player_speed_scale"])
@@ -291,7 +292,8 @@ class World(PlayerActions):
         return trace.trace_record(self)
 
 
-def default_rngs(seed: int) -> tuple[np.random.Generator, ...]:
+def default_rngs(seed: int) -> Generators:
     """Three independent generators (spawns, guards, player) from one integer seed."""
     children = np.random.SeedSequence(seed).spawn(3)
-    return tuple(np.random.Generator(np.random.PCG64(c)) for c in children)
+    spawn, guards, player = (np.random.Generator(np.random.PCG64(c)) for c in children)
+    return spawn, guards, player
