@@ -8,7 +8,6 @@ same spec gives bit-identical metrics in any process and any order.
 
 from __future__ import annotations
 
-import json
 import time
 import zlib
 from collections.abc import Mapping, Sequence
@@ -22,7 +21,8 @@ from ai.stimuli import load_stimulus
 from navmesh.level import cached_level
 
 from .config import Config
-from .world import World
+from .trace import attach_trace
+from .world import Generators, World
 
 
 def _tag(name: str) -> int:
@@ -56,7 +56,7 @@ class TrialSpec:
         return "/".join(parts)
 
 
-def trial_rngs(spec: TrialSpec, level_name: str) -> tuple[np.random.Generator, ...]:
+def trial_rngs(spec: TrialSpec, level_name: str) -> Generators:
     """Generators for spawns, guards and player, derived from the trial's identity.
 
     The spawn generator depends on (root, level, abstraction, seed) only, so every guard
@@ -71,7 +71,8 @@ def trial_rngs(spec: TrialSpec, level_name: str) -> tuple[np.random.Generator, .
         np.random.SeedSequence(base + who + [_tag("guards")]),
         np.random.SeedSequence(base + who + [_tag("player")]),
     ]
-    return tuple(np.random.Generator(np.random.PCG64(s)) for s in seqs)
+    spawn, guards, player = (np.random.Generator(np.random.PCG64(s)) for s in seqs)
+    return spawn, guards, player
 
 
 def make_world(spec: TrialSpec, config: Config | None = None, **world_kwargs: Any) -> World:
@@ -114,15 +115,7 @@ def run_trial(
     started = time.perf_counter()
     world = make_world(spec, config)
     if trace is not None:
-
-        def write(w: World) -> None:
-            record = w.trace_record()
-            if explain:
-                record["explain"] = w.guard_ai.explain(0)
-            trace.write(json.dumps(record) + "\n")
-
-        write(world)
-        world.on_tick = write
+        attach_trace(world, trace, explain=explain)
     metrics = world.run()
     return {
         **{k: v for k, v in asdict(spec).items() if k not in ("overrides", "stimuli")},
