@@ -43,7 +43,7 @@ import numpy as np
 
 from navmesh.graph import UNREACHABLE_HOPS, NodeGraph
 
-from .params import _NON_NEGATIVE, _POSITIVE, _UNIT, _Params
+from .params import _NON_NEGATIVE, _UNIT, _Params
 from .view import Event, WorldView
 
 #: importlib.metadata entry-point group under which installed packages register stimuli
@@ -59,7 +59,11 @@ class StimulusError(ValueError):
 
 @dataclass(frozen=True)
 class StimulusParams(_Params):
-    """The ``[stimuli]`` section of the config: the paper's values (SPEC §5) are the defaults."""
+    """The ``[stimuli]`` section of the config: the paper's values (SPEC §5) are the defaults.
+
+    The section's player-action keys (``throw_cooldown``, ``throw_radius``, ``decoy_reach``,
+    ``takedown_range``) are the world's (``game.actions.ActionParams``), not these.
+    """
 
     #: footstep noise while sprinting (and a thrown decoy's landing): −A·α^d up to max_hops
     noise_amplitude: float = 3.0
@@ -73,15 +77,10 @@ class StimulusParams(_Params):
     rain_falloff: float = 0.7
     #: weather at the start of a trial
     raining: bool = False
-    #: thrown decoy: seconds between throws, landing within this Manhattan radius in cells
-    throw_cooldown: float = 10.0
-    throw_radius: int = 4
     #: static decoy: −A·β^d over the whole map, removed after guards stood on it this long
     decoy_amplitude: float = 5.0
     decoy_falloff: float = 0.8
     decoy_disarm_time: float = 3.0
-    #: the player activates a level decoy within this distance (world units, line of sight)
-    decoy_reach: float = 1.5
     #: corpse: −A·γ^t·δ^d, removed after guards inspected it this long
     corpse_amplitude: float = 4.0
     corpse_decay: float = 0.95
@@ -92,8 +91,6 @@ class StimulusParams(_Params):
     corpse_alert_weight: float = 0.9
     #: a guard within this many hops of a decoy or corpse counts as standing on / inspecting it
     inspect_hops: int = 1
-    #: take-down: guard centre within this distance of the player's, player outside its cone
-    takedown_range: float = 1.0
 
     _ranges = {
         "noise_amplitude": _NON_NEGATIVE,
@@ -103,19 +100,15 @@ class StimulusParams(_Params):
         "noise_threshold": _NON_NEGATIVE,
         "rain_amplitude_scale": _NON_NEGATIVE,
         "rain_falloff": _UNIT,
-        "throw_cooldown": _NON_NEGATIVE,
-        "throw_radius": (0, math.inf, True, False),
         "decoy_amplitude": _NON_NEGATIVE,
         "decoy_falloff": _UNIT,
         "decoy_disarm_time": _NON_NEGATIVE,
-        "decoy_reach": _NON_NEGATIVE,
         "corpse_amplitude": _NON_NEGATIVE,
         "corpse_decay": _UNIT,
         "corpse_falloff": _UNIT,
         "corpse_inspect_time": _NON_NEGATIVE,
         "corpse_alert_weight": (0.0, 1.0, True, True),
         "inspect_hops": (0, math.inf, True, False),
-        "takedown_range": _POSITIVE,
     }
 
 
@@ -203,6 +196,9 @@ class Stimulus:
     name: str = "stimulus"
     node: int = -1
     marker: bool = False
+    #: the index of the level decoy this stimulus is (``-1``: none); the world asks it to
+    #: tell whether that decoy is already on
+    decoy: int = -1
     done: bool = False
     information_weight_floor: float | None = None
 

@@ -2,6 +2,8 @@
 
 Run as ``python benchmarks/NAME.py``, this folder is ``sys.path[0]`` and a script named
 like a package (``ai.py``) would shadow it; this swaps the folder for the project root.
+``tests/`` goes on the path too, so benchmarks import the test oracle (``tests/oracle.py``)
+under the same name the tests do.
 """
 
 import sys
@@ -12,3 +14,5 @@ ROOT = HERE.parent
 sys.path[:] = [p for p in sys.path if Path(p or ".").resolve() != HERE]
 if str(ROOT) not in sys.path:
     sys.path.insert(0, str(ROOT))
+if str(ROOT / "tests") not in sys.path:
+    sys.path.append(str(ROOT / "tests"))

@@ -10,7 +10,7 @@ and the same random point pairs:
 * ``pynavmesh`` — the pure-Python ``pynavmesh`` package on the SAME triangles (passed
   clockwise in its XZ plane, which it needs) with its own A* + funnel.
 
-Each: path length ÷ Euclidean shortest path (``navmesh.visibility.VisibilityGraph``)
+Each: path length ÷ Euclidean shortest path (``tests/oracle.py``, the test oracle)
 as mean / p95 / max, and the median query time.  A second table compares the
 triangulation methods (A*-only quality is what depends on the mesh).
 """
@@ -29,7 +29,7 @@ from shapely import Polygon, box
 from shapely.affinity import rotate
 
 from navmesh.mesh import METHODS, NavMesh
-from navmesh.visibility import VisibilityGraph
+from oracle import VisibilityGraph
 
 
 def synthetic_level(seed: int = 7) -> Polygon:

@@ -21,14 +21,14 @@ import pymunk
 
 import _paths  # noqa: F401  (project importable, this folder unshadowed)
 from game.config import Config
-from game.trial import TrialSpec, _cached_level, run_trial
+from game.trial import TrialSpec, run_trial
 from navmesh.graph import graph_for
-from navmesh.level import bundled_level_names
+from navmesh.level import bundled_level_names, cached_level
 
 
 def skeleton_trial(level_name: str, seed: int, dt: float = 0.05, duration: float = 60.0) -> float:
     """The bare loop the issue compares against: pymunk bodies + numpy, no AI, no metrics."""
-    level = _cached_level(level_name)
+    level = cached_level(level_name)
     graph = graph_for(level, "grid")
     rng = np.random.default_rng(seed)
     started = time.perf_counter()

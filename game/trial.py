@@ -8,22 +8,21 @@ same spec gives bit-identical metrics in any process and any order.
 
 from __future__ import annotations
 
-import json
 import time
 import zlib
 from collections.abc import Mapping, Sequence
 from dataclasses import asdict, dataclass
-from functools import lru_cache
 from typing import IO, Any
 
 import numpy as np
 
 from ai import make_guard_ai, make_player_policy
 from ai.stimuli import load_stimulus
-from navmesh.level import Level, load_level
+from navmesh.level import cached_level
 
 from .config import Config
-from .world import World
+from .trace import attach_trace
+from .world import Generators, World
 
 
 def _tag(name: str) -> int:
@@ -57,7 +56,7 @@ class TrialSpec:
         return "/".join(parts)
 
 
-def trial_rngs(spec: TrialSpec, level_name: str) -> tuple[np.random.Generator, ...]:
+def trial_rngs(spec: TrialSpec, level_name: str) -> Generators:
     """Generators for spawns, guards and player, derived from the trial's identity.
 
     The spawn generator depends on (root, level, abstraction, seed) only, so every guard
@@ -72,18 +71,14 @@ def trial_rngs(spec: TrialSpec, level_name: str) -> tuple[np.random.Generator, .
         np.random.SeedSequence(base + who + [_tag("guards")]),
         np.random.SeedSequence(base + who + [_tag("player")]),
     ]
-    return tuple(np.random.Generator(np.random.PCG64(s)) for s in seqs)
-
-
-@lru_cache(maxsize=16)
-def _cached_level(name: str) -> Level:
-    return load_level(name)
+    spawn, guards, player = (np.random.Generator(np.random.PCG64(s)) for s in seqs)
+    return spawn, guards, player
 
 
 def make_world(spec: TrialSpec, config: Config | None = None, **world_kwargs: Any) -> World:
     """Build the world of a trial (level and graph are cached per process)."""
     config = config or Config.load(dict(spec.overrides))
-    level = _cached_level(spec.level)
+    level = cached_level(spec.level)
     if spec.stimuli:
         world_kwargs.setdefault("stimuli", [load_stimulus(s) for s in spec.stimuli])
     return World(
@@ -120,15 +115,7 @@ def run_trial(
     started = time.perf_counter()
     world = make_world(spec, config)
     if trace is not None:
-
-        def write(w: World) -> None:
-            record = w.trace_record()
-            if explain:
-                record["explain"] = w.guard_ai.explain(0)
-            trace.write(json.dumps(record) + "\n")
-
-        write(world)
-        world.on_tick = write
+        attach_trace(world, trace, explain=explain)
     metrics = world.run()
     return {
         **{k: v for k, v in asdict(spec).items() if k not in ("overrides", "stimuli")},

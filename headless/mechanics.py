@@ -35,7 +35,6 @@ import sys
 import time
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
-from functools import lru_cache
 from pathlib import Path
 from typing import Any
 
@@ -43,12 +42,14 @@ import numpy as np
 
 from ai import make_guard_ai
 from ai.stimuli import footstep_rule
-from ai.view import Event, PlayerPolicy, WorldView
+from ai.view import Action, Event, PlayerPolicy, WorldView
 from game.config import Config
 from game.trial import TrialSpec, trial_rngs
 from game.world import World
 from navmesh.graph import NodeGraph
-from navmesh.level import Level, load_level
+from navmesh.level import cached_level, load_level
+
+from .stats import mean_or_nan, percentile_ci
 
 #: guards cannot see and the player cannot be hurt: only the mechanic informs the guards
 BLIND = {"world.view_range": 0.0, "world.attack_range": 0.0, "world.player_hp": 1.0e6}
@@ -77,11 +78,6 @@ class WanderPlayer(PlayerPolicy):
         return options[int(self.rng.integers(len(options)))]
 
 
-@lru_cache(maxsize=8)
-def _level(name: str) -> Level:
-    return load_level(name)
-
-
 def make_world(
     level: str, abstraction: str, seed: int, overrides: Mapping[str, Any], *,
     player: PlayerPolicy | None = None, tag: str = "mechanics",
@@ -89,7 +85,7 @@ def make_world(
     """A PF world of the ``fixed`` scenario whose generators depend on (level, seed, tag) only."""
     config = Config.load({k: str(v).lower() if isinstance(v, bool) else str(v)
                           for k, v in overrides.items()})
-    lvl = _level(level)
+    lvl = cached_level(level)
     spec = TrialSpec(level, abstraction, "pf", tag, "fixed", seed)
     return World(lvl, abstraction, make_guard_ai("pf", config.section("pf")), player,
                  config=config, scenario="fixed", rngs=trial_rngs(spec, lvl.name))
@@ -147,7 +143,7 @@ def footstep(level: str, abstraction: str, seed: int) -> Measures:
     for sprint in (True, False):
         world = make_world(level, abstraction, seed, {**BLIND, "world.sprint_factor": 1.0},
                            player=WanderPlayer())
-        world.sprinting = sprint
+        world.perform(Action("sprint" if sprint else "walk"))
         run_until(world, horizon)
         values.append(float(world.metrics()["avg_guard_player_dist"]))
     return {"footstep: mean nearest guard-player distance, units":
@@ -230,9 +226,7 @@ def concealment(level: str, abstraction: str, seed: int) -> Measures:
                 raise ValueError(f"level {level} has no concealment zone")
             options = np.flatnonzero(mask)
             spot = int(options[world.stimuli.ctx.rng.integers(len(options))])
-        world.player.place(tuple(float(v) for v in world.graph.positions[spot]))
-        world.player.node = spot
-        world.m.first_detect_time = None
+        world.place_player(spot, forget_detection=True)
 
         seen_from: list[float] = []
 
@@ -241,7 +235,7 @@ def concealment(level: str, abstraction: str, seed: int) -> Measures:
                 px, py = w.player.pos
                 seen_from.append(min(math.hypot(w.guards[i].pos[0] - px, w.guards[i].pos[1] - py)
                                      for i in w.seen_by))
-                w.done = True
+                w.stop()
 
         run_until(world, horizon, stop_when_seen)
         first = world.m.first_detect_time
@@ -340,13 +334,8 @@ def run_job(job: tuple[str, str, str, int]) -> list[Row]:
 
 
 def bootstrap_ci(values: np.ndarray, rng: np.random.Generator, n: int = BOOTSTRAP) -> tuple[float, float]:
-    """95 % percentile bootstrap CI of the mean of ``values`` (resampling seeds)."""
-    values = np.asarray(values, dtype=float)
-    if len(values) == 0:
-        return (math.nan, math.nan)
-    means = values[rng.integers(len(values), size=(n, len(values)))].mean(axis=1)
-    low, high = np.percentile(means, [2.5, 97.5])
-    return float(low), float(high)
+    """95 % percentile bootstrap CI of the mean of ``values`` (resampling seeds) with ``rng``."""
+    return percentile_ci(values, rng, n)
 
 
 @dataclass
@@ -399,9 +388,7 @@ def summarise(rows: Sequence[Row]) -> list[Summary]:
         ).reshape(-1, 2)
         on, control = pairs[:, 0], pairs[:, 1]
 
-        def mean(v: np.ndarray) -> float:
-            return float(v.mean()) if len(v) else math.nan
-
+        mean = mean_or_nan
         out.append(Summary(measure, len(pairs), mean(on), bootstrap_ci(on, rng), mean(control),
                            bootstrap_ci(control, rng), mean(on - control),
                            bootstrap_ci(on - control, rng), expected))

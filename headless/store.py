@@ -3,7 +3,8 @@
 ``DIR/results.sqlite`` (stdlib :mod:`sqlite3`, WAL journal) holds
 
 * ``trials`` — one row per trial, keyed by :attr:`game.trial.TrialSpec.key`: the trial's
-  identity, seed, config hash, one column per metric, the per-node ``visits`` and
+  identity, seed, config hash, one column per registered metric (:mod:`game.metrics`;
+  opening an older store adds the columns of metrics registered since), the per-node ``visits`` and
   ``attacks`` lists (zlib-compressed JSON, ``json.loads(zlib.decompress(blob))``), the error
   text (``NULL`` on success), the wall time and when it finished;
 * ``meta`` — key/value text: the preset (its TOML text and its expanded design as JSON) and
@@ -32,7 +33,9 @@ from pathlib import Path
 from types import TracebackType
 from typing import Any
 
-__all__ = ["IDENTITY", "METRICS", "METRIC_NAMES", "STORE_NAME", "ResultStore", "StoredTrial", "pack",
+from game.metrics import Metric, registered_metrics
+
+__all__ = ["IDENTITY", "STORE_NAME", "ResultStore", "StoredTrial", "metric_columns", "pack",
            "unpack"]
 
 STORE_NAME = "results.sqlite"
@@ -42,20 +45,16 @@ IDENTITY: tuple[str, ...] = ("level", "abstraction", "guards", "player", "scenar
                              "root_seed")
 """Identity columns of a trial (with ``config_hash`` they say exactly what ran)."""
 
-METRICS: tuple[tuple[str, str], ...] = (
-    ("captured", "INTEGER"),
-    ("capture_time", "REAL"),
-    ("captures", "INTEGER"),
-    ("coverage", "REAL"),
-    ("avg_guard_player_dist", "REAL"),
-    ("first_detect_time", "REAL"),
-    ("backtracks", "INTEGER"),
-)
-"""Metric columns (SPEC §7/§9); any other metric a trial reports goes to ``extra_metrics``."""
 
-METRIC_NAMES: tuple[str, ...] = tuple(name for name, _ in METRICS)
+def metric_columns() -> tuple[tuple[str, str], ...]:
+    """``(name, SQL type)`` of every registered metric: the store's metric columns (SPEC §7/§9).
 
-_SCHEMA = f"""
+    Any other metric a trial reports goes to ``extra_metrics``.
+    """
+    return tuple((m.name, m.sql_type) for m in registered_metrics())
+
+
+_TABLE = """
 CREATE TABLE IF NOT EXISTS trials (
     key TEXT PRIMARY KEY,
     level TEXT NOT NULL,
@@ -68,7 +67,7 @@ CREATE TABLE IF NOT EXISTS trials (
     root_seed INTEGER NOT NULL,
     overrides TEXT NOT NULL,
     config_hash TEXT,
-    {", ".join(f"{name} {kind}" for name, kind in METRICS)},
+    {metrics},
     extra_metrics TEXT,
     visits BLOB,
     attacks BLOB,
@@ -82,20 +81,21 @@ CREATE TABLE IF NOT EXISTS meta (
 );
 """
 
-_COLUMNS: tuple[str, ...] = (
-    "key", "level", "level_ref", "abstraction", "guards", "player", "scenario", "seed",
-    "root_seed", "overrides", "config_hash", *METRIC_NAMES, "extra_metrics", "visits",
-    "attacks", "error", "wall_time", "finished_at",
-)
+_HEAD: tuple[str, ...] = ("key", "level", "level_ref", "abstraction", "guards", "player",
+                          "scenario", "seed", "root_seed", "overrides", "config_hash")
+_TAIL: tuple[str, ...] = ("extra_metrics", "visits", "attacks", "error", "wall_time",
+                          "finished_at")
 
-# A key is written once: a success is never overwritten, a failure is replaced by a later
-# attempt (a rerun retries failed trials), and the key is never duplicated.
-_UPSERT = (
-    f"INSERT INTO trials ({', '.join(_COLUMNS)}) VALUES ({', '.join('?' * len(_COLUMNS))}) "
-    f"ON CONFLICT(key) DO UPDATE SET "
-    + ", ".join(f"{c} = excluded.{c}" for c in _COLUMNS if c != "key")
-    + " WHERE trials.error IS NOT NULL"
-)
+
+def _upsert(columns: tuple[str, ...]) -> str:
+    # A key is written once: a success is never overwritten, a failure is replaced by a later
+    # attempt (a rerun retries failed trials), and the key is never duplicated.
+    return (
+        f"INSERT INTO trials ({', '.join(columns)}) VALUES ({', '.join('?' * len(columns))}) "
+        f"ON CONFLICT(key) DO UPDATE SET "
+        + ", ".join(f"{c} = excluded.{c}" for c in columns if c != "key")
+        + " WHERE trials.error IS NOT NULL"
+    )
 
 
 def pack(values: list[Any] | None) -> bytes | None:
@@ -136,6 +136,8 @@ class ResultStore:
 
     def __init__(self, path: str | Path, *, readonly: bool = False) -> None:
         self.path = Path(path)
+        #: the metrics registered when the store was opened: its metric columns
+        self.metrics: tuple[Metric, ...] = registered_metrics()
         if readonly:
             uri = f"{self.path.resolve().as_uri()}?mode=ro"
             self.db = sqlite3.connect(uri, uri=True, timeout=30.0)
@@ -143,9 +145,22 @@ class ResultStore:
             self.db = sqlite3.connect(self.path, timeout=30.0)
             self.db.execute("PRAGMA journal_mode=WAL")
             self.db.execute("PRAGMA synchronous=NORMAL")  # WAL: durable against a killed process
-            self.db.executescript(_SCHEMA)
+            kinds = ", ".join(f"{m.name} {m.sql_type}" for m in self.metrics)
+            self.db.executescript(_TABLE.format(metrics=kinds))
+            self._add_missing_columns()
             self.db.commit()
         self.db.row_factory = sqlite3.Row
+        present = {r[1] for r in self.db.execute("PRAGMA table_info(trials)")}
+        #: metric columns the file has (a read-only older store may lack new ones)
+        self.metric_names = tuple(m.name for m in self.metrics if m.name in present)
+        self.columns = (*_HEAD, *self.metric_names, *_TAIL)
+
+    def _add_missing_columns(self) -> None:
+        """A store written before a metric was registered gets its column (NULL so far)."""
+        present = {r[1] for r in self.db.execute("PRAGMA table_info(trials)")}
+        for m in self.metrics:
+            if m.name not in present:
+                self.db.execute(f"ALTER TABLE trials ADD COLUMN {m.name} {m.sql_type}")
 
     # ------------------------------------------------------------------ context manager
     def __enter__(self) -> ResultStore:
@@ -200,7 +215,7 @@ class ResultStore:
         kept as it is.
         """
         metrics = dict(row.get("metrics") or {})
-        extra = {k: v for k, v in metrics.items() if k not in METRIC_NAMES}
+        extra = {k: v for k, v in metrics.items() if k not in self.metric_names}
         values = {
             "key": row["key"],
             "level": row["level"],
@@ -213,7 +228,7 @@ class ResultStore:
             "root_seed": int(row.get("root_seed", 0)),
             "overrides": json.dumps(dict(row.get("overrides") or {}), sort_keys=True),
             "config_hash": row.get("config_hash"),
-            **{name: _metric_value(metrics.get(name)) for name in METRIC_NAMES},
+            **{name: _metric_value(metrics.get(name)) for name in self.metric_names},
             "extra_metrics": json.dumps(extra, sort_keys=True) if extra else None,
             "visits": pack(row.get("visits")),
             "attacks": pack(row.get("attacks")),
@@ -222,7 +237,7 @@ class ResultStore:
             "finished_at": _now(),
         }
         with self.db:
-            self.db.execute(_UPSERT, [values[c] for c in _COLUMNS])
+            self.db.execute(_upsert(self.columns), [values[c] for c in self.columns])
 
     def trials(self, *, failed: bool = False, heatmaps: bool = False) -> Iterator[StoredTrial]:
         """Finished trials (or, with ``failed=True``, the failed ones) in identity order.
@@ -230,13 +245,16 @@ class ResultStore:
         ``visits``/``attacks`` are decoded only with ``heatmaps=True``.
         """
         where = "error IS NOT NULL" if failed else "error IS NULL"
-        columns = [c for c in _COLUMNS if heatmaps or c not in ("visits", "attacks")]
+        columns = [c for c in self.columns if heatmaps or c not in ("visits", "attacks")]
         order = ", ".join(IDENTITY)
         query = f"SELECT {', '.join(columns)} FROM trials WHERE {where} ORDER BY {order}"
         for r in self.db.execute(query):
             trial = StoredTrial(zip(columns, tuple(r)))
-            if trial.get("captured") is not None:
-                trial["captured"] = bool(trial["captured"])
+            for m in self.metrics:
+                if m.kind == "bool" and trial.get(m.name) is not None:
+                    trial[m.name] = bool(trial[m.name])
+                elif m.name not in self.metric_names:
+                    trial[m.name] = None  # an older read-only store without the column
             trial["overrides"] = json.loads(trial["overrides"])
             trial["extra_metrics"] = json.loads(trial["extra_metrics"] or "{}")
             if heatmaps:

@@ -20,7 +20,6 @@ from collections import OrderedDict
 from collections.abc import Callable, Hashable, Iterator, Sequence
 from dataclasses import dataclass, field
 from functools import lru_cache
-from pathlib import Path
 from typing import TYPE_CHECKING, Literal
 
 import numpy as np
@@ -534,13 +533,6 @@ def dense_bytes(n_nodes: int) -> int:
     return 16 * n_nodes * n_nodes
 
 
-@lru_cache(maxsize=32)
-def _graph_for_file(path: str, mtime: float, abstraction: str) -> NodeGraph:
-    from .level import load_level
-
-    return build_graph(load_level(path), abstraction)
-
-
 def build_graph(level: Level, abstraction: str) -> NodeGraph:
     """Build the node graph of ``level`` in ``abstraction`` ("grid" or "partition")."""
     if abstraction == "grid":
@@ -552,9 +544,26 @@ def build_graph(level: Level, abstraction: str) -> NodeGraph:
     raise ValueError(f"unknown abstraction {abstraction!r} (choose grid or partition)")
 
 
+@dataclass(frozen=True)
+class _GraphKey:
+    """A level's content identity and an abstraction; carries (but is not keyed on) the level."""
+
+    digest: str
+    abstraction: str
+    level: Level = field(compare=False, repr=False)
+
+
+@lru_cache(maxsize=32)
+def _cached_graph(key: _GraphKey) -> NodeGraph:
+    return build_graph(key.level, key.abstraction)
+
+
 def graph_for(level: Level, abstraction: str) -> NodeGraph:
-    """The node graph of a level, cached per process for levels loaded from files."""
-    if level.path is not None:
-        path = Path(level.path)
-        return _graph_for_file(str(path.resolve()), path.stat().st_mtime, abstraction)
+    """The node graph of a level, cached per process on the level's content (``Level.digest``).
+
+    The graph is always built from the level given, so it matches it even when the file
+    changed since; levels built in memory (no digest) are not cached.
+    """
+    if level.digest is not None:
+        return _cached_graph(_GraphKey(level.digest, abstraction, level))
     return build_graph(level, abstraction)

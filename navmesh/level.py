@@ -19,10 +19,12 @@ Every problem with a file is reported as a :class:`LevelError` whose message is 
 
 from __future__ import annotations
 
+import hashlib
+import importlib.resources
 import json
 import math
-from dataclasses import dataclass
-from functools import cached_property
+from dataclasses import dataclass, field
+from functools import cached_property, lru_cache
 from pathlib import Path
 from typing import Any, NoReturn
 
@@ -41,9 +43,12 @@ __all__ = [
     "Level",
     "LevelError",
     "bundled_level_names",
+    "cached_level",
     "load_level",
     "parse_level",
+    "register_zone_kind",
     "resolve_level_path",
+    "zone_kinds",
 ]
 
 FORMAT = "stealth-level/1"
@@ -53,13 +58,52 @@ MAX_CELLS = 1_000_000
 """Largest allowed occupancy grid (rows x cols); checked before anything is rasterised."""
 
 ZONE_KINDS = ("dark", "concealment")
-"""Zone kinds a level may declare; ``Level.zones`` always has exactly these keys."""
+"""The built-in zone kinds; a stimulus may declare more with :func:`register_zone_kind`."""
 
-LEVELS_DIR = Path(__file__).resolve().parent.parent / "assets" / "levels"
-"""Folder of the bundled levels, found relative to this package."""
+_zone_kinds: list[str] = list(ZONE_KINDS)
+
+
+def register_zone_kind(kind: str) -> None:
+    """Let levels (JSON and Tiled) declare zones of ``kind``, e.g. from a stimulus plugin.
+
+    Registering a known kind again does nothing. Levels parsed afterwards have the kind as
+    a key of ``Level.zones``; levels parsed before keep the kinds they were parsed with.
+    """
+    if not isinstance(kind, str) or not kind.strip() or kind != kind.strip():
+        raise ValueError(f"a zone kind is a non-empty string without spaces around it, got {kind!r}")
+    if kind not in _zone_kinds:
+        _zone_kinds.append(kind)
+
+
+def zone_kinds() -> tuple[str, ...]:
+    """Zone kinds a level may declare now: the built-in ones, then the registered ones."""
+    return tuple(_zone_kinds)
+
+
+def _bundled_levels_dir() -> Path:
+    """``assets/levels`` of a source checkout, else the copy installed as package data.
+
+    The checkout wins so that a worktree on ``PYTHONPATH`` sees its own levels even while an
+    editable install of another checkout is on the path; a wheel ships the same folder as
+    the data package ``stealthfield_assets`` (pyproject ``package-dir``).
+    """
+    root = Path(__file__).resolve().parent.parent
+    if (root / "pyproject.toml").is_file() and (root / "assets" / "levels").is_dir():
+        return root / "assets" / "levels"
+    try:
+        return Path(str(importlib.resources.files("stealthfield_assets") / "levels"))
+    except ModuleNotFoundError:  # neither a checkout nor an install with the data package
+        return root / "assets" / "levels"
+
+
+LEVELS_DIR = _bundled_levels_dir()
+"""Folder of the bundled levels (see :func:`_bundled_levels_dir`)."""
 
 _REQUIRED_KEYS = ("format", "name", "guards")
-_OPTIONAL_KEYS = ("cell_size", "outline", "obstacles", "grid", "zones", "decoys")
+_OPTIONAL_KEYS = (
+    "cell_size", "outline", "obstacles", "grid", "zones", "decoys",
+    "player", "exits", "collectibles",
+)
 _ALLOWED_KEYS = _REQUIRED_KEYS + _OPTIONAL_KEYS
 _AREA_EPS = 1e-12  # areas at or below this are "zero" (float noise from shapely overlays)
 # JSON arrays and numbers; tuples and numpy scalars are accepted from in-memory levels too.
@@ -97,7 +141,9 @@ class Level:
     collinear vertices; its exterior is counter-clockwise in world coordinates
     (``exterior.is_ccw``; clockwise on a y-down screen) and its holes the other way.
     ``eq=False``: levels compare and hash by identity (numpy and shapely fields have no
-    useful ``==``).
+    useful ``==``); ``digest`` is the content identity instead: the SHA-256 of the file
+    bytes the level was parsed from (``None`` for a level built in memory), the key of the
+    per-process caches (:func:`cached_level`, :func:`navmesh.graph.graph_for`).
     """
 
     name: str
@@ -108,6 +154,13 @@ class Level:
     zones: dict[str, tuple[Polygon, ...]]
     guards: tuple[Point, ...]
     decoys: tuple[Point, ...]
+    digest: str | None = None
+    player: Point | None = None
+    """The player's start in interactive play and with ``world.spawns = "level"``."""
+    exits: tuple[Polygon, ...] = ()
+    """Areas the player leaves the level through (objectives, issue 16)."""
+    collectibles: tuple[Point, ...] = ()
+    """Items the player can pick up (objectives, issue 16)."""
 
     def __post_init__(self) -> None:
         occupancy = np.array(self.occupancy, dtype=bool)  # private copy, then frozen
@@ -195,20 +248,34 @@ def resolve_level_path(path_or_name: str | Path) -> Path:
 
 
 def load_level(path_or_name: str | Path) -> Level:
-    """Load and validate a level from a JSON file or a bundled level name.
+    """Load and validate a level from a JSON file, a Tiled map or a bundled level name.
 
-    Errors name the file as the caller gave it (a bundled level by its file name).
+    A ``.tmj`` file, or a JSON file whose ``"type"`` is ``"map"``, is a Tiled map, read by
+    :mod:`navmesh.tiled` into the same structure. Errors name the file as the caller gave
+    it (a bundled level by its file name).
     """
-    path = resolve_level_path(path_or_name)
-    source = str(path_or_name) if path == Path(path_or_name) else path.name
-    data = _read_json(path, source)
-    return parse_level(data, source, path=path)
+    content = _read_level_file(path_or_name)
+    return _parse_content(content)
 
 
-def parse_level(data: Any, source: str = "<memory>", *, path: Path | None = None) -> Level:
+def cached_level(path_or_name: str | Path) -> Level:
+    """:func:`load_level`, memoised per process on the file's resolved path and content.
+
+    The one level cache of the project: the file is read on every call (levels are a few
+    kB) and its SHA-256 compared, so an edited file is parsed again — never a stale level —
+    while repeated trials on an unchanged file share one :class:`Level` (and, through
+    ``Level.digest``, one node graph).
+    """
+    return _cached_parse(_read_level_file(path_or_name))
+
+
+def parse_level(
+    data: Any, source: str = "<memory>", *, path: Path | None = None, digest: str | None = None
+) -> Level:
     """Validate an in-memory level (the decoded JSON object) and build its :class:`Level`.
 
-    ``source`` names the level in error messages; ``path`` is stored on the result.
+    ``source`` names the level in error messages; ``path`` and ``digest`` (the content
+    identity of the file it came from) are stored on the result.
     """
     src = source
     if not isinstance(data, dict):
@@ -251,6 +318,19 @@ def parse_level(data: Any, source: str = "<memory>", *, path: Path | None = None
     level_spots = dict(walkable=walkable, occupancy=occupancy, outline=outline, cell_size=cell_size)
     guards = _parse_spots(data["guards"], src, "guards", required=True, **level_spots)
     decoys = _parse_spots(data.get("decoys", []), src, "decoys", required=False, **level_spots)
+    collectibles = _parse_spots(
+        data.get("collectibles", []), src, "collectibles", required=False, **level_spots
+    )
+    player = None
+    if "player" in data:
+        player = _point(data["player"], src, "player")
+        _check_spot(player, src, "player", **level_spots)
+    exits = data.get("exits", [])
+    if not isinstance(exits, _ARRAY_TYPES):
+        _fail(src, "exits", f"expected an array of polygons, got {_describe(exits)}")
+    exit_areas = tuple(_polygons_overlapping(
+        exits, walkable, src, "exits", "exit does not overlap the walkable area"
+    ))
     return Level(
         name=name,
         path=path,
@@ -260,16 +340,50 @@ def parse_level(data: Any, source: str = "<memory>", *, path: Path | None = None
         zones=zones,
         guards=guards,
         decoys=decoys,
+        digest=digest,
+        player=player,
+        exits=exit_areas,
+        collectibles=collectibles,
     )
 
 
 # --------------------------------------------------------------------------- reading
 
 
-def _read_json(path: Path, src: str) -> Any:
-    """Read and decode a level file; every failure becomes a one-line LevelError."""
+@dataclass(frozen=True)
+class _LevelFile:
+    """A level file's bytes; equal (and hashed) by resolved path and SHA-256 of the bytes only."""
+
+    resolved: str
+    digest: str
+    raw: bytes = field(compare=False, repr=False)
+    path: Path = field(compare=False)
+    source: str = field(compare=False)
+
+
+def _read_level_file(path_or_name: str | Path) -> _LevelFile:
+    path = resolve_level_path(path_or_name)
+    source = str(path_or_name) if path == Path(path_or_name) else path.name
+    raw = _read_bytes(path, source)
+    return _LevelFile(str(path.resolve()), hashlib.sha256(raw).hexdigest(), raw, path, source)
+
+
+def _parse_content(content: _LevelFile) -> Level:
+    data = _decode_json(content.raw, content.source)
+    if content.path.suffix.lower() == ".tmj" or (isinstance(data, dict) and data.get("type") == "map"):
+        from navmesh.tiled import load_tiled  # lazy: imports this module and pytiled-parser
+
+        return load_tiled(content.path, content.source, content.digest)
+    return parse_level(data, content.source, path=content.path, digest=content.digest)
+
+
+_cached_parse = lru_cache(maxsize=32)(_parse_content)
+
+
+def _read_bytes(path: Path, src: str) -> bytes:
+    """Read a level file; every failure becomes a one-line LevelError."""
     try:
-        raw = path.read_bytes()
+        return path.read_bytes()
     except FileNotFoundError:
         _fail(src, "file", "no such file")
     except IsADirectoryError:
@@ -278,6 +392,10 @@ def _read_json(path: Path, src: str) -> Any:
         _fail(src, "file", "permission denied")
     except OSError as exc:
         _fail(src, "file", f"cannot read ({exc.strerror or exc})")
+
+
+def _decode_json(raw: bytes, src: str) -> Any:
+    """Decode a level file's bytes; every failure becomes a one-line LevelError."""
     if not raw.strip():
         _fail(src, "file", "is empty")
     try:
@@ -577,11 +695,12 @@ def _check_connected(occupancy: np.ndarray, src: str, field: str) -> None:
 def _parse_zones(value: Any, walkable: Polygon, src: str) -> dict[str, tuple[Polygon, ...]]:
     if not isinstance(value, dict):
         _fail(src, "zones", f"expected an object of zone kind -> polygons, got {_describe(value)}")
-    zones: dict[str, tuple[Polygon, ...]] = {kind: () for kind in ZONE_KINDS}
+    kinds = zone_kinds()
+    zones: dict[str, tuple[Polygon, ...]] = {kind: () for kind in kinds}
     for kind, polygons in value.items():
         field = f"zones.{kind}"
-        if kind not in ZONE_KINDS:
-            _fail(src, field, f"unknown zone kind (known kinds: {', '.join(ZONE_KINDS)})")
+        if kind not in kinds:
+            _fail(src, field, f"unknown zone kind (known kinds: {', '.join(kinds)})")
         if not isinstance(polygons, _ARRAY_TYPES):
             _fail(src, field, f"expected an array of polygons, got {_describe(polygons)}")
         zones[kind] = tuple(_polygons_overlapping(
@@ -601,28 +720,44 @@ def _parse_spots(
     outline: Polygon | None,
     cell_size: float,
 ) -> tuple[Point, ...]:
-    """Guard or decoy points: each in the walkable area and in a walkable grid cell."""
+    """Guard, decoy or collectible points: each checked by :func:`_check_spot`."""
     if not isinstance(value, _ARRAY_TYPES):
         _fail(src, field, f"expected an array of [x, y] points, got {_describe(value)}")
     if required and not value:
         _fail(src, field, "needs at least one point")
     points = tuple(_point(p, src, f"{field}[{i}]") for i, p in enumerate(value))
-    rows, cols = occupancy.shape
-    for i, (x, y) in enumerate(points):
-        where = f"point ({x:g}, {y:g})"
-        in_grid = 0 <= x <= cols * cell_size and 0 <= y <= rows * cell_size
-        in_level = in_grid if outline is None else bool(shapely.intersects_xy(outline, x, y))
-        if not in_level:
-            _fail(src, f"{field}[{i}]", f"{where} is outside the level")
-        if not shapely.intersects_xy(walkable, x, y):
-            _fail(src, f"{field}[{i}]", f"{where} is inside a wall")
-        row = min(int(y // cell_size), rows - 1)
-        col = min(int(x // cell_size), cols - 1)
-        if not occupancy[row, col]:
-            _fail(
-                src,
-                f"{field}[{i}]",
-                f"{where} is in grid cell (row {row}, col {col}), which is not walkable "
-                "(its centre is inside a wall); move the point into a walkable cell",
-            )
+    level = dict(walkable=walkable, occupancy=occupancy, outline=outline, cell_size=cell_size)
+    for i, point in enumerate(points):
+        _check_spot(point, src, f"{field}[{i}]", **level)
     return points
+
+
+def _check_spot(
+    point: Point,
+    src: str,
+    field: str,
+    *,
+    walkable: Polygon,
+    occupancy: np.ndarray,
+    outline: Polygon | None,
+    cell_size: float,
+) -> None:
+    """A spawn point must lie in the walkable area and in a walkable grid cell."""
+    x, y = point
+    rows, cols = occupancy.shape
+    where = f"point ({x:g}, {y:g})"
+    in_grid = 0 <= x <= cols * cell_size and 0 <= y <= rows * cell_size
+    in_level = in_grid if outline is None else bool(shapely.intersects_xy(outline, x, y))
+    if not in_level:
+        _fail(src, field, f"{where} is outside the level")
+    if not shapely.intersects_xy(walkable, x, y):
+        _fail(src, field, f"{where} is inside a wall")
+    row = min(int(y // cell_size), rows - 1)
+    col = min(int(x // cell_size), cols - 1)
+    if not occupancy[row, col]:
+        _fail(
+            src,
+            field,
+            f"{where} is in grid cell (row {row}, col {col}), which is not walkable "
+            "(its centre is inside a wall); move the point into a walkable cell",
+        )

@@ -1,4 +1,4 @@
-"""Navmesh paths against the exact visibility-graph oracle (navmesh.visibility.VisibilityGraph).
+"""Navmesh paths against the exact visibility-graph oracle (``tests/oracle.py``).
 
 Quality criteria (issue): path length ÷ Euclidean shortest path over random point pairs,
 mean ≤ 1.01 and max ≤ 1.05.  The default (exact) search must in fact match the oracle to
@@ -22,7 +22,7 @@ from shapely import LineString, Polygon, box
 
 from navmesh.funnel import funnel
 from navmesh.mesh import METHODS, NavMesh, NavPath, OutsideError
-from navmesh.visibility import VisibilityGraph
+from oracle import VisibilityGraph
 
 try:  # the polygon strategies live next door
     from tests.test_mesh import BUNDLED, grid_polygons, polygons, rect_with_holes

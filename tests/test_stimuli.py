@@ -28,6 +28,7 @@ from ai.stimuli import (
     zones_from_config,
 )
 from ai.view import Event, GuardAI, WorldView
+from game.actions import ActionParams
 from game.config import Config
 from game.trial import TrialSpec, make_world
 from game.world import Refused, World
@@ -319,13 +320,14 @@ def test_falloff_helper():
 
 
 def test_parameters_default_to_the_paper_and_validate():
-    p = StimulusParams.from_mapping(Config.load().section("stimuli"))
+    p = StimulusParams.from_mapping(ActionParams.split(Config.load().section("stimuli"))[1])
     assert (p.noise_amplitude, p.noise_falloff, p.noise_max_hops, p.noise_decay,
             p.noise_threshold) == (3.0, 0.6, 5, 0.8, 0.1)
     assert (p.decoy_amplitude, p.decoy_falloff, p.decoy_disarm_time) == (5.0, 0.8, 3.0)
     assert (p.corpse_amplitude, p.corpse_decay, p.corpse_falloff, p.corpse_inspect_time) == (
         4.0, 0.95, 0.7, 10.0)
-    assert (p.throw_cooldown, p.throw_radius) == (10.0, 4)
+    actions = ActionParams.split(Config.load().section("stimuli"))[0]
+    assert (actions.throw_cooldown, actions.throw_radius) == (10.0, 4)
     assert 3.0 * p.rain_amplitude_scale == 1.5 and p.rain_falloff == 0.7
     with pytest.raises(ValueError, match="noise_falloff"):
         StimulusParams.from_mapping({"noise_falloff": 1.5})
@@ -427,7 +429,7 @@ def test_a_throw_lands_within_radius_4_never_in_a_wall_with_a_10_s_cooldown():
     tick(w)
     # too far: clamped to the nearest node within 4 cells (Manhattan) of the player's cell
     for target in [(9.5, 9.5), (5.5, 5.5), (0.2, 0.2), (-30.0, 4.0)]:
-        w._next_throw = 0.0
+        w.next_throw = 0.0
         node = w.landing_node(*target)
         landed_at = tuple(w.graph.positions[node])
         assert manhattan_cells(landed_at, w.player.pos) <= 4

@@ -1,7 +1,6 @@
 """``stealth replay TRACE``: play back a trace written by ``stealth sim --trace FILE``.
 
-A trace is JSON lines, one per AI tick (1 s apart): ``t``, ``player {pos, hp, node}``,
-``guards [{pos, heading, sees_player, node, target, state, active}]``, ``events``. Between
+A trace is JSON lines, one per AI tick (1 s apart), read by :mod:`game.trace`. Between
 two lines every agent is moved along the shortest walkable path between its two recorded
 positions (the navmesh funnel path, so nobody walks through a wall corner), at constant
 speed; a jump longer than any agent can walk in that time (a respawn) is shown as a jump.
@@ -14,190 +13,25 @@ the positions (``--abstraction`` overrides).
 from __future__ import annotations
 
 import argparse
-import json
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
 
 import numpy as np
 
+from game.agents import max_agent_speed
 from game.front.render import DrawOptions, FrameLoop, Renderer, default_window_size, init_pygame, pygame
 from game.scene import GuardDrawing, PlayerDrawing, Scene, SceneBuilder
+from game.trace import GuardRecord, Trace, TraceError, TraceLine, load_trace, parse_line
+from game.zones import ZoneMap
 from navmesh.graph import NodeGraph
 from navmesh.level import Level
 
-#: Faster than any agent walks (2 units/s × capture 1.2 × sprint 1.6 ≈ 3.84, plus slack):
-#: a longer move between two lines is a teleport (respawn) and is not interpolated.
-MAX_SPEED = 6.0
+#: Slack on the fastest agent's speed (``game.agents.max_agent_speed``): a move between two
+#: lines longer than this many times what that agent walks in the time is a teleport
+#: (respawn) and is not interpolated.
+JUMP_SLACK = 1.5
 SPEEDS = (0.125, 0.25, 0.5, 1.0, 2.0, 4.0, 8.0, 16.0, 32.0)
-
-
-class TraceError(ValueError):
-    """A trace file that cannot be replayed; the message is one line."""
-
-
-@dataclass(frozen=True)
-class GuardRecord:
-    """One guard in one trace line."""
-
-    pos: tuple[float, float]
-    heading: float
-    sees_player: bool
-    node: int | None = None
-    target: int | None = None
-    state: str = ""
-    active: bool = True
-
-
-@dataclass(frozen=True)
-class TraceLine:
-    """One line (one AI tick) of a trace."""
-
-    t: float
-    player_pos: tuple[float, float]
-    hp: float
-    player_node: int | None
-    guards: tuple[GuardRecord, ...]
-    events: tuple[str, ...]
-    #: nodes of the active stimuli that sit somewhere (decoys, corpses, throws), if traced
-    markers: tuple[int, ...] = ()
-
-
-@dataclass(frozen=True)
-class Trace:
-    """A parsed trace and what its lines say about the trial (level, abstraction)."""
-
-    path: str
-    lines: tuple[TraceLine, ...]
-    level: str | None = None
-    abstraction: str | None = None
-
-
-# ---------------------------------------------------------------------------- parsing
-
-
-def _need(obj: dict[str, Any], key: str, where: str) -> Any:
-    if key not in obj:
-        raise TraceError(f"{where}: missing field {key!r}")
-    return obj[key]
-
-
-def _number(value: Any, where: str) -> float:
-    if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
-        raise TraceError(f"{where}: expected a finite number, got {json.dumps(value)[:40]}")
-    return float(value)
-
-
-def _point(value: Any, where: str) -> tuple[float, float]:
-    if not isinstance(value, list) or len(value) != 2:
-        raise TraceError(f"{where}: expected [x, y], got {json.dumps(value)[:40]}")
-    return (_number(value[0], f"{where}[0]"), _number(value[1], f"{where}[1]"))
-
-
-def _node(value: Any, where: str) -> int | None:
-    if value is None:
-        return None
-    if isinstance(value, bool) or not isinstance(value, int) or value < 0:
-        raise TraceError(f"{where}: expected a node number, got {json.dumps(value)[:40]}")
-    return int(value)
-
-
-def _object(value: Any, where: str) -> dict[str, Any]:
-    if not isinstance(value, dict):
-        raise TraceError(f"{where}: expected an object, got {json.dumps(value)[:40]}")
-    return value
-
-
-def parse_line(record: Any, where: str) -> TraceLine:
-    """Validate one decoded trace line."""
-    record = _object(record, where)
-    player = _object(_need(record, "player", where), f"{where}: player")
-    guards_raw = _need(record, "guards", where)
-    if not isinstance(guards_raw, list) or not guards_raw:
-        raise TraceError(f"{where}: guards: expected a non-empty list")
-    guards = []
-    for k, raw in enumerate(guards_raw):
-        at = f"{where}: guards[{k}]"
-        g = _object(raw, at)
-        sees = _need(g, "sees_player", at)
-        if not isinstance(sees, bool):
-            raise TraceError(f"{at}.sees_player: expected true or false")
-        active = g.get("active", True)
-        if not isinstance(active, bool):
-            raise TraceError(f"{at}.active: expected true or false")
-        guards.append(GuardRecord(
-            pos=_point(_need(g, "pos", at), f"{at}.pos"),
-            heading=_number(_need(g, "heading", at), f"{at}.heading"),
-            sees_player=sees,
-            node=_node(g.get("node"), f"{at}.node"),
-            target=_node(g.get("target"), f"{at}.target"),
-            state=str(g.get("state") or ""),
-            active=active,
-        ))
-    events_raw = record.get("events", [])
-    if not isinstance(events_raw, list):
-        raise TraceError(f"{where}: events: expected a list")
-    events = tuple(
-        str(e.get("kind", "?")) if isinstance(e, dict) else str(e) for e in events_raw
-    )
-    markers = tuple(
-        int(st["node"]) for st in record.get("stimuli", []) or []
-        if isinstance(st, dict) and isinstance(st.get("node"), int) and not isinstance(st["node"], bool)
-        and st["node"] >= 0 and st.get("name") not in ("footstep", "rain")
-    ) if isinstance(record.get("stimuli", []), list) else ()
-    return TraceLine(
-        markers=markers,
-        t=_number(_need(record, "t", where), f"{where}: t"),
-        player_pos=_point(_need(player, "pos", f"{where}: player"), f"{where}: player.pos"),
-        hp=_number(_need(player, "hp", f"{where}: player"), f"{where}: player.hp"),
-        player_node=_node(player.get("node"), f"{where}: player.node"),
-        guards=tuple(guards),
-        events=events,
-    )
-
-
-def load_trace(path: str | Path) -> Trace:
-    """Read and validate a trace file; every problem is a one-line :class:`TraceError`."""
-    name = str(path)
-    try:
-        text = Path(path).read_text(encoding="utf-8")
-    except FileNotFoundError:
-        raise TraceError(f"{name}: no such file") from None
-    except IsADirectoryError:
-        raise TraceError(f"{name}: is a directory, not a trace file") from None
-    except UnicodeDecodeError:
-        raise TraceError(f"{name}: not a text file (expected JSON lines)") from None
-    except OSError as error:
-        raise TraceError(f"{name}: cannot read ({error.strerror or error})") from None
-    lines: list[TraceLine] = []
-    level = abstraction = None
-    for number, raw in enumerate(text.splitlines(), start=1):
-        if not raw.strip():
-            continue
-        where = f"{name} line {number}"
-        try:
-            record = json.loads(raw)
-        except json.JSONDecodeError as error:
-            raise TraceError(f"{where}: not JSON ({error.msg} at column {error.colno})") from None
-        except (ValueError, RecursionError) as error:
-            raise TraceError(f"{where}: not JSON ({error})") from None
-        line = parse_line(record, where)
-        if isinstance(record.get("level"), str):
-            level = record["level"]
-        if record.get("abstraction") in ("grid", "partition"):
-            abstraction = record["abstraction"]
-        if lines:
-            if len(line.guards) != len(lines[0].guards):
-                raise TraceError(f"{where}: guards: {len(line.guards)} guards, but the first "
-                                 f"line has {len(lines[0].guards)}")
-            if line.t <= lines[-1].t:
-                raise TraceError(f"{where}: t: {line.t:g} does not increase (previous {lines[-1].t:g})")
-        lines.append(line)
-    if not lines:
-        raise TraceError(f"{name}: empty trace (no JSON lines)")
-    return Trace(name, tuple(lines), level, abstraction)
 
 
 def detect_abstraction(trace: Trace, graphs: dict[str, NodeGraph]) -> str:
@@ -266,7 +100,8 @@ def _lerp_angle(a: float, b: float, f: float) -> float:
 class Playback:
     """Agent states at any time of a trace, interpolated along walkable paths."""
 
-    def __init__(self, trace: Trace, level: Level) -> None:
+    def __init__(self, trace: Trace, level: Level, max_speed: float | None = None) -> None:
+        from game.config import Config
         from navmesh.graph import graph_for
 
         self.trace = trace
@@ -277,6 +112,8 @@ class Playback:
         self.mesh = mesh
         self._routes: dict[tuple[int, int], _Route] = {}
         self._player_heading = 0.0
+        speed = max_agent_speed(Config.defaults()) if max_speed is None else max_speed
+        self.jump_speed = JUMP_SLACK * speed
 
     @property
     def start(self) -> float:
@@ -302,7 +139,7 @@ class Playback:
             except ValueError:  # a recorded point on the wall line: walk straight
                 points = np.array([a, b], dtype=float)
             route = _Route(points, jump=False)
-            if route.length > MAX_SPEED * dt + 1e-6:
+            if route.length > self.jump_speed * dt + 1e-6:
                 route = _Route(np.array([a, b], dtype=float), jump=True)
             self._routes[key] = route
         return route
@@ -356,14 +193,10 @@ class ReplayViewer(FrameLoop):
         self.hp_max = max(float(config["world.player_hp"]), max(line.hp for line in trace.lines))
         self.builder = SceneBuilder(level, self.graph, view_range=self.view_range,
                                     fov_deg=float(config["world.fov_deg"]))
-        self.concealment = self._zone_mask(level, "concealment")
-        # Per node, the factor on the view range while the player stands there (as World).
-        self.view_scale = np.ones(self.graph.n)
-        for key, value in config.section("zones").items():
-            if key.endswith("_view_scale"):
-                mask = self._zone_mask(level, key[: -len("_view_scale")])
-                self.view_scale = np.where(mask, np.minimum(self.view_scale, float(value)), self.view_scale)
-        self.playback = Playback(trace, level)
+        zones = ZoneMap.build(level, self.graph, config)  # the world's zones, as in the trial
+        self.concealment = zones.mask("concealment")
+        self.view_scale = zones.view_scale
+        self.playback = Playback(trace, level, max_agent_speed(config))
         self.abstraction = abstraction
         self.t = self.playback.start
         self.speed = float(speed)
@@ -376,15 +209,6 @@ class ReplayViewer(FrameLoop):
         self.screen = pygame.display.set_mode(size, pygame.RESIZABLE)
         self.renderer = Renderer(self.builder.static, self.screen.get_size())
         self.clock = pygame.time.Clock()
-
-    def _zone_mask(self, level: Level, kind: str) -> np.ndarray:
-        import shapely
-
-        mask = np.zeros(self.graph.n, dtype=bool)
-        x, y = self.graph.positions[:, 0], self.graph.positions[:, 1]
-        for polygon in level.zones.get(kind, ()):
-            mask |= shapely.intersects_xy(polygon, x, y)
-        return mask
 
     # ------------------------------------------------------------------ input
     HELP = ("Space pause", "Right/Left step one tick", "Up/Down speed", "Home restart",
@@ -532,6 +356,6 @@ def cmd_replay(args: argparse.Namespace) -> int:
 
 
 __all__: Sequence[str] = [
-    "Playback", "ReplayViewer", "Trace", "TraceError", "TraceLine", "cmd_replay",
-    "detect_abstraction", "load_trace",
+    "GuardRecord", "Playback", "ReplayViewer", "Trace", "TraceError", "TraceLine", "cmd_replay",
+    "detect_abstraction", "load_trace", "parse_line",
 ]

@@ -1,0 +1,239 @@
+"""Traces (SPEC §9): one JSON line per AI tick, written by the world, read by the replay.
+
+A trace line holds ``t``, ``player {pos, hp, node}``, ``guards [{pos, heading,
+sees_player, node, target, state, active}]``, ``events`` and, when stimuli are active,
+``stimuli [{name, node, ...}]``. :func:`trace_record` builds a line from a
+:class:`~game.world.World`, :func:`attach_trace` writes one per AI tick to a file, and
+:func:`load_trace` reads and validates a file (every problem is a one-line
+:class:`TraceError`).
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from dataclasses import dataclass
+from pathlib import Path
+from typing import IO, TYPE_CHECKING, Any
+
+if TYPE_CHECKING:
+    from .world import World
+
+
+def _round(value: float | None) -> float | None:
+    return None if value is None else round(value, 6)
+
+
+def trace_record(world: World) -> dict[str, Any]:
+    """One trace line (SPEC §9): time, agents, who sees the player, HP, events."""
+    return {
+        "t": _round(world.t),
+        "player": {
+            "pos": [round(v, 4) for v in world.player.pos],
+            "hp": round(world.hp, 4),
+            "node": world.player.node,
+        },
+        "guards": [
+            {
+                "pos": [round(v, 4) for v in g.pos],
+                "heading": round(g.heading, 4),
+                "sees_player": i in world.seen_by,
+                "node": g.node,
+                "target": g.target,
+                "state": world.guard_ai.state_name(i),
+                "active": g.active,
+            }
+            for i, g in enumerate(world.guards)
+        ],
+        "events": [
+            {"kind": e.kind, "node": e.node, "t": _round(e.t), **dict(e.data)}
+            for e in world.tick_events
+        ],
+        **({"stimuli": [s.describe() for s in world.stimuli.active]} if world.stimuli else {}),
+    }
+
+
+def attach_trace(world: World, handle: IO[str], *, explain: bool = False) -> None:
+    """Write ``world``'s line now (t = 0) and after every AI tick to ``handle``.
+
+    With ``explain`` each line also carries the first guard's last decision explained.
+    """
+
+    def write(w: World) -> None:
+        record = w.trace_record()
+        if explain:
+            record["explain"] = w.guard_ai.explain(0)
+        handle.write(json.dumps(record) + "\n")
+
+    write(world)
+    world.on_tick = write
+
+
+class TraceError(ValueError):
+    """A trace file that cannot be replayed; the message is one line."""
+
+
+@dataclass(frozen=True)
+class GuardRecord:
+    """One guard in one trace line."""
+
+    pos: tuple[float, float]
+    heading: float
+    sees_player: bool
+    node: int | None = None
+    target: int | None = None
+    state: str = ""
+    active: bool = True
+
+
+@dataclass(frozen=True)
+class TraceLine:
+    """One line (one AI tick) of a trace."""
+
+    t: float
+    player_pos: tuple[float, float]
+    hp: float
+    player_node: int | None
+    guards: tuple[GuardRecord, ...]
+    events: tuple[str, ...]
+    #: nodes of the active stimuli that sit somewhere (decoys, corpses, throws), if traced
+    markers: tuple[int, ...] = ()
+
+
+@dataclass(frozen=True)
+class Trace:
+    """A parsed trace and what its lines say about the trial (level, abstraction)."""
+
+    path: str
+    lines: tuple[TraceLine, ...]
+    level: str | None = None
+    abstraction: str | None = None
+
+
+# ---------------------------------------------------------------------------- parsing
+
+
+def _need(obj: dict[str, Any], key: str, where: str) -> Any:
+    if key not in obj:
+        raise TraceError(f"{where}: missing field {key!r}")
+    return obj[key]
+
+
+def _number(value: Any, where: str) -> float:
+    if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
+        raise TraceError(f"{where}: expected a finite number, got {json.dumps(value)[:40]}")
+    return float(value)
+
+
+def _point(value: Any, where: str) -> tuple[float, float]:
+    if not isinstance(value, list) or len(value) != 2:
+        raise TraceError(f"{where}: expected [x, y], got {json.dumps(value)[:40]}")
+    return (_number(value[0], f"{where}[0]"), _number(value[1], f"{where}[1]"))
+
+
+def _node(value: Any, where: str) -> int | None:
+    if value is None:
+        return None
+    if isinstance(value, bool) or not isinstance(value, int) or value < 0:
+        raise TraceError(f"{where}: expected a node number, got {json.dumps(value)[:40]}")
+    return int(value)
+
+
+def _object(value: Any, where: str) -> dict[str, Any]:
+    if not isinstance(value, dict):
+        raise TraceError(f"{where}: expected an object, got {json.dumps(value)[:40]}")
+    return value
+
+
+def parse_line(record: Any, where: str) -> TraceLine:
+    """Validate one decoded trace line."""
+    record = _object(record, where)
+    player = _object(_need(record, "player", where), f"{where}: player")
+    guards_raw = _need(record, "guards", where)
+    if not isinstance(guards_raw, list) or not guards_raw:
+        raise TraceError(f"{where}: guards: expected a non-empty list")
+    guards = []
+    for k, raw in enumerate(guards_raw):
+        at = f"{where}: guards[{k}]"
+        g = _object(raw, at)
+        sees = _need(g, "sees_player", at)
+        if not isinstance(sees, bool):
+            raise TraceError(f"{at}.sees_player: expected true or false")
+        active = g.get("active", True)
+        if not isinstance(active, bool):
+            raise TraceError(f"{at}.active: expected true or false")
+        guards.append(GuardRecord(
+            pos=_point(_need(g, "pos", at), f"{at}.pos"),
+            heading=_number(_need(g, "heading", at), f"{at}.heading"),
+            sees_player=sees,
+            node=_node(g.get("node"), f"{at}.node"),
+            target=_node(g.get("target"), f"{at}.target"),
+            state=str(g.get("state") or ""),
+            active=active,
+        ))
+    events_raw = record.get("events", [])
+    if not isinstance(events_raw, list):
+        raise TraceError(f"{where}: events: expected a list")
+    events = tuple(
+        str(e.get("kind", "?")) if isinstance(e, dict) else str(e) for e in events_raw
+    )
+    markers = tuple(
+        int(st["node"]) for st in record.get("stimuli", []) or []
+        if isinstance(st, dict) and isinstance(st.get("node"), int) and not isinstance(st["node"], bool)
+        and st["node"] >= 0 and st.get("name") not in ("footstep", "rain")
+    ) if isinstance(record.get("stimuli", []), list) else ()
+    return TraceLine(
+        markers=markers,
+        t=_number(_need(record, "t", where), f"{where}: t"),
+        player_pos=_point(_need(player, "pos", f"{where}: player"), f"{where}: player.pos"),
+        hp=_number(_need(player, "hp", f"{where}: player"), f"{where}: player.hp"),
+        player_node=_node(player.get("node"), f"{where}: player.node"),
+        guards=tuple(guards),
+        events=events,
+    )
+
+
+def load_trace(path: str | Path) -> Trace:
+    """Read and validate a trace file; every problem is a one-line :class:`TraceError`."""
+    name = str(path)
+    try:
+        text = Path(path).read_text(encoding="utf-8")
+    except FileNotFoundError:
+        raise TraceError(f"{name}: no such file") from None
+    except IsADirectoryError:
+        raise TraceError(f"{name}: is a directory, not a trace file") from None
+    except UnicodeDecodeError:
+        raise TraceError(f"{name}: not a text file (expected JSON lines)") from None
+    except OSError as error:
+        raise TraceError(f"{name}: cannot read ({error.strerror or error})") from None
+    lines: list[TraceLine] = []
+    level = abstraction = None
+    for number, raw in enumerate(text.splitlines(), start=1):
+        if not raw.strip():
+            continue
+        where = f"{name} line {number}"
+        try:
+            record = json.loads(raw)
+        except json.JSONDecodeError as error:
+            raise TraceError(f"{where}: not JSON ({error.msg} at column {error.colno})") from None
+        except (ValueError, RecursionError) as error:
+            raise TraceError(f"{where}: not JSON ({error})") from None
+        line = parse_line(record, where)
+        if isinstance(record.get("level"), str):
+            level = record["level"]
+        if record.get("abstraction") in ("grid", "partition"):
+            abstraction = record["abstraction"]
+        if lines:
+            if len(line.guards) != len(lines[0].guards):
+                raise TraceError(f"{where}: guards: {len(line.guards)} guards, but the first "
+                                 f"line has {len(lines[0].guards)}")
+            if line.t <= lines[-1].t:
+                raise TraceError(f"{where}: t: {line.t:g} does not increase (previous {lines[-1].t:g})")
+        lines.append(line)
+    if not lines:
+        raise TraceError(f"{name}: empty trace (no JSON lines)")
+    return Trace(name, tuple(lines), level, abstraction)
+
+
+__all__ = ["GuardRecord", "Trace", "TraceError", "TraceLine", "attach_trace", "load_trace",
+           "parse_line", "trace_record"]

@@ -1,0 +1,97 @@
+"""The README of a results directory: what each file is and where our metrics differ.
+
+The metric table is generated from the metric registry (:mod:`game.metrics`): one line per
+Table 3 column with its scenario and definition.
+"""
+
+from __future__ import annotations
+
+import json
+from collections.abc import Mapping, Sequence
+from pathlib import Path
+
+from .stats import BOOTSTRAP_RESAMPLES, BOOTSTRAP_SEED
+from .store import STORE_NAME
+from .tables import table_columns
+
+__all__ = ["readme"]
+
+
+def readme(directory: Path, meta: Mapping[str, str], done: int, skipped_heat: int, failed: int,
+           files: Sequence[Path]) -> str:
+    """The README text: design, files, metrics, differences from the paper."""
+    design = json.loads(meta.get("design", "{}"))
+    total = meta.get("total_trials", "?")
+    names = sorted(str(p.relative_to(directory)) for p in files)
+    heat = [n for n in names if n.startswith("heatmaps/")]
+    lines = [
+        f"# Results: preset `{meta.get('preset_name', '?')}`",
+        "",
+        f"{done} of {total} trials finished" + (f", {failed} failed" if failed else "")
+        + f" (config hash `{meta.get('config_hash', '?')}`). Levels: "
+        f"{', '.join(design.get('level_names', []))}; abstractions: "
+        f"{', '.join(design.get('abstractions', []))}; guard modes: "
+        f"{', '.join(design.get('guards', []))}; player policies: "
+        f"{', '.join(design.get('players', []))}; scenarios: "
+        f"{', '.join(design.get('scenarios', []))}; {len(design.get('seeds', []))} seeds; "
+        f"root seed {design.get('root_seed', 0)}; overrides: "
+        f"{json.dumps(design.get('set', {})) if design.get('set') else 'none'}.",
+        "",
+        "Regenerate with `stealth report " + str(directory) + "`; an unfinished sweep is resumed "
+        "by running the same `stealth run` command again (finished trials are skipped).",
+        "",
+        "## Files",
+        "",
+        "| file | contents |",
+        "|---|---|",
+        f"| `{STORE_NAME}` | the store: one row per trial (SQLite; see docs/experiments.md) |",
+        "| `trials.csv` | one row per finished trial: identity, seed, config hash, every "
+        "metric, `wall_time` (s) last |",
+        "| `table.md`, `table.csv` | paper Table 3: mean ± std and 95 % bootstrap CI per "
+        "abstraction × guard mode × player policy (`table.csv` also has n per cell) |",
+    ]
+    for name in names:
+        if name.startswith("aggregate_"):
+            lines.append(f"| `{name}` | the paper's *Aggregated performance* figure: bars "
+                         "(mean) with 95 % bootstrap CI whiskers per guard mode × policy |")
+    if heat:
+        lines.append(f"| `heatmaps/` ({len(heat)} files) | `{{level}}_{{abstraction}}_{{mode}}_"
+                     "{visit,attack}.csv/.png`: per-node counts summed over every trial of "
+                     "that level, abstraction and guard mode (all player policies, scenarios "
+                     "and seeds). Grid CSV: rows × cols matrix, blank = wall. Partition CSV: "
+                     "`triangle,x,y,value` per navmesh triangle (centroid). |")
+    if failed:
+        lines.append("| `failed.csv` | trials that raised: identity and the error text |")
+    lines += [
+        "",
+        "## Metrics",
+        "",
+        "| column | trials | definition |",
+        "|---|---|---|",
+        *(f"| {c.title} | {c.scenario} | {c.metric.definition} |" for c in table_columns()),
+        "",
+        "Each cell: mean ± sample standard deviation (ddof = 1) [95 % percentile-bootstrap "
+        f"confidence interval of the mean, {BOOTSTRAP_RESAMPLES} resamples, generator "
+        f"`PCG64(SeedSequence([{BOOTSTRAP_SEED}, crc32(label)]))`, label = "
+        "`abstraction/guards/player/column`]. Levels and seeds are pooled, as in the paper.",
+        "",
+        "Heatmap units: *visit* = number of times a guard entered the node; *attack* = "
+        "guard-seconds during which a guard was in attack range of the player while the player "
+        "stood on the node (= HP the player lost there).",
+        "",
+        "## Where these numbers differ from the paper",
+        "",
+        "* **Coverage is a true fraction in [0, 1].** The paper reports partition coverage "
+        "above 1 (e.g. PF 1.72), which cannot be a fraction of nodes; ours counts each node "
+        "once, so partition and grid coverage are on the same scale but not comparable to the "
+        "paper's partition column.",
+        "* CaptureTime and FirstDetectTime are censored at the trial duration (see above), not "
+        "averaged over the trials where the event happened.",
+        "* Distances are shortest-path distances on the node graph in world units (1 unit = 1 "
+        "grid cell), on both abstractions.",
+        "* The paper gives mean ± std only; the bootstrap intervals are ours.",
+    ]
+    if skipped_heat:
+        lines += ["", f"{skipped_heat} trials had no usable per-node counts and are not "
+                      "in the heatmaps."]
+    return "\n".join(lines) + "\n"

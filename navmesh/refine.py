@@ -1,0 +1,441 @@
+"""Ruppert refinement: a mutable constrained triangulation with Lawson flips and Steiner points.
+
+The second stage of :meth:`navmesh.mesh.NavMesh.build`: the base triangulation of
+:mod:`navmesh.triangulate` is flipped to constrained Delaunay, then refined until every
+angle reaches the minimum angle and every area the maximum area (see ``docs/navmesh.md``).
+:func:`fix_degenerate` uses the same flips to remove the zero-area triangles earcut emits.
+"""
+
+from __future__ import annotations
+
+import heapq
+import math
+
+import numpy as np
+
+from navmesh.triangulate import edge_neighbors, orient_ccw
+
+__all__ = ["Refiner", "fix_degenerate"]
+
+
+def _orient2(ax: float, ay: float, bx: float, by: float, cx: float, cy: float) -> float:
+    return (bx - ax) * (cy - ay) - (by - ay) * (cx - ax)
+
+
+class Refiner:
+    """Mutable constrained triangulation: Lawson flips and Ruppert-style Steiner refinement.
+
+    Boundary edges (no neighbour) are the constraints and are never flipped.  Every
+    insertion splits whole triangles (a point on an edge splits both sides), so the
+    result is conforming by construction.
+    """
+
+    def __init__(self, verts: np.ndarray, tris: np.ndarray, rings: list[np.ndarray], tol: float) -> None:
+        self.x: list[float] = verts[:, 0].tolist()
+        self.y: list[float] = verts[:, 1].tolist()
+        self.tri: list[list[int]] = tris.tolist()
+        self.nbr: list[list[int]] = edge_neighbors(tris).tolist()
+        self.tol = tol
+        self.dirty: list[int] = []
+        self.n_input = len(verts)
+        # input segments and the input angle at every input vertex (for the small-angle rule)
+        lookup = {(float(x), float(y)): i for i, (x, y) in enumerate(verts)}
+        self.small: set[int] = set()
+        for ring in rings:
+            ids = [lookup[(float(x), float(y))] for x, y in ring]
+            for j, v in enumerate(ids):
+                p, n = ids[j - 1], ids[(j + 1) % len(ids)]
+                # walkable (interior) angle: counter-clockwise from the next to the previous vertex
+                ux, uy = self.x[n] - self.x[v], self.y[n] - self.y[v]
+                wx, wy = self.x[p] - self.x[v], self.y[p] - self.y[v]
+                ang = math.atan2(ux * wy - uy * wx, ux * wx + uy * wy) % (2.0 * math.pi)
+                if ang < math.radians(60.0):
+                    self.small.add(v)
+        self.on_seg: dict[int, tuple[int, int]] = {}  # Steiner vertex -> input segment end points
+        self.bound: dict[tuple[int, int], int] = {}  # directed boundary edge -> triangle
+        for t, (tri, nb) in enumerate(zip(self.tri, self.nbr)):
+            for k in range(3):
+                if nb[k] < 0:
+                    self.bound[(tri[(k + 1) % 3], tri[(k + 2) % 3])] = t
+
+    # -------------------------------------------------------------- primitives
+    def _orient(self, a: int, b: int, c: int) -> float:
+        x, y = self.x, self.y
+        return _orient2(x[a], y[a], x[b], y[b], x[c], y[c])
+
+    def _incircle(self, a: int, b: int, c: int, d: int) -> float:
+        """Positive when d lies inside the circumcircle of the counter-clockwise (a, b, c)."""
+        x, y = self.x, self.y
+        adx, ady = x[a] - x[d], y[a] - y[d]
+        bdx, bdy = x[b] - x[d], y[b] - y[d]
+        cdx, cdy = x[c] - x[d], y[c] - y[d]
+        ad, bd, cd = adx * adx + ady * ady, bdx * bdx + bdy * bdy, cdx * cdx + cdy * cdy
+        det = adx * (bdy * cd - bd * cdy) - ady * (bdx * cd - bd * cdx) + ad * (bdx * cdy - bdy * cdx)
+        scale = max(ad, bd, cd)
+        return det / (scale * scale) if scale > 0 else 0.0
+
+    def _replace_nbr(self, t: int, old: int, new: int) -> None:
+        if t >= 0:
+            nb = self.nbr[t]
+            nb[nb.index(old)] = new
+
+    def _should_flip(self, t: int, k: int) -> bool:
+        u = self.nbr[t][k]
+        if u < 0:
+            return False
+        tri = self.tri[t]
+        a, b, c = tri[k], tri[(k + 1) % 3], tri[(k + 2) % 3]
+        d = self.tri[u][self.nbr[u].index(t)]
+        if self._incircle(a, b, c, d) <= 1e-12:
+            return False
+        return self._orient(a, b, d) > 0 and self._orient(a, d, c) > 0
+
+    def _flip(self, t: int, k: int) -> int:
+        """Flip the edge opposite vertex k of t; afterwards both t and u start with that vertex."""
+        tri, nb = self.tri[t], self.nbr[t]
+        a, b, c = tri[k], tri[(k + 1) % 3], tri[(k + 2) % 3]
+        u, n_b, n_c = nb[k], nb[(k + 1) % 3], nb[(k + 2) % 3]
+        j = self.nbr[u].index(t)
+        utri, unb = self.tri[u], self.nbr[u]
+        d = utri[j]
+        n_uc, n_ub = unb[(j + 1) % 3], unb[(j + 2) % 3]
+        self.tri[t] = [a, b, d]
+        self.nbr[t] = [n_uc, u, n_c]
+        self.tri[u] = [a, d, c]
+        self.nbr[u] = [n_ub, n_b, t]
+        self._replace_nbr(n_uc, u, t)
+        self._replace_nbr(n_b, t, u)
+        if n_uc < 0:
+            self.bound[(b, d)] = t
+        if n_b < 0:
+            self.bound[(c, a)] = u
+        self.dirty += (t, u)
+        return u
+
+    def legalize_all(self) -> None:
+        """Lawson flips until every interior edge is locally Delaunay (any triangulation -> CDT)."""
+        stack = [(t, k) for t in range(len(self.tri)) for k in range(3)]
+        while stack:
+            t, k = stack.pop()
+            if self._should_flip(t, k):
+                u = self._flip(t, k)
+                stack += ((t, 0), (t, 2), (u, 0), (u, 1))
+
+    def _legalize_around(self, p: int, tris: list[int]) -> None:
+        stack = list(tris)
+        while stack:
+            t = stack.pop()
+            k = self.tri[t].index(p)
+            if self._should_flip(t, k):
+                u = self._flip(t, k)
+                stack += (t, u)
+
+    def _new_vertex(self, px: float, py: float) -> int:
+        self.x.append(px)
+        self.y.append(py)
+        return len(self.x) - 1
+
+    def insert_in_triangle(self, t: int, px: float, py: float) -> int:
+        p = self._new_vertex(px, py)
+        a, b, c = self.tri[t]
+        na, nb, nc = self.nbr[t]
+        t1, t2 = len(self.tri), len(self.tri) + 1
+        self.tri[t] = [a, b, p]
+        self.nbr[t] = [t1, t2, nc]
+        self.tri.append([b, c, p])
+        self.nbr.append([t2, t, na])
+        self.tri.append([c, a, p])
+        self.nbr.append([t, t1, nb])
+        self._replace_nbr(na, t, t1)
+        self._replace_nbr(nb, t, t2)
+        if na < 0:
+            self.bound[(b, c)] = t1
+        if nb < 0:
+            self.bound[(c, a)] = t2
+        self.dirty += (t, t1, t2)
+        self._legalize_around(p, [t, t1, t2])
+        return p
+
+    def insert_on_edge(self, t: int, k: int, px: float, py: float) -> int:
+        """Insert a point on the edge opposite vertex k of t (splitting both sides)."""
+        p = self._new_vertex(px, py)
+        tri, nbt = self.tri[t], self.nbr[t]
+        a, b, c = tri[k], tri[(k + 1) % 3], tri[(k + 2) % 3]
+        u, n_b, n_c = nbt[k], nbt[(k + 1) % 3], nbt[(k + 2) % 3]
+        t1 = len(self.tri)
+        if u < 0:
+            self.tri[t] = [a, b, p]
+            self.nbr[t] = [-1, t1, n_c]
+            self.tri.append([a, p, c])
+            self.nbr.append([-1, n_b, t])
+            self._replace_nbr(n_b, t, t1)
+            if n_b < 0:
+                self.bound[(c, a)] = t1
+            self.bound.pop((b, c), None)
+            self.bound[(b, p)] = t
+            self.bound[(p, c)] = t1
+            self.dirty += (t, t1)
+            self._legalize_around(p, [t, t1])
+            return p
+        j = self.nbr[u].index(t)
+        utri, unb = self.tri[u], self.nbr[u]
+        d = utri[j]
+        n_uc, n_ub = unb[(j + 1) % 3], unb[(j + 2) % 3]
+        u1 = t1 + 1
+        self.tri[t] = [a, b, p]
+        self.nbr[t] = [u1, t1, n_c]
+        self.tri.append([a, p, c])
+        self.nbr.append([u, n_b, t])
+        self.tri[u] = [d, c, p]
+        self.nbr[u] = [t1, u1, n_ub]
+        self.tri.append([d, p, b])
+        self.nbr.append([t, n_uc, u])
+        self._replace_nbr(n_b, t, t1)
+        self._replace_nbr(n_uc, u, u1)
+        if n_b < 0:
+            self.bound[(c, a)] = t1
+        if n_uc < 0:
+            self.bound[(b, d)] = u1
+        self.dirty += (t, t1, u, u1)
+        self._legalize_around(p, [t, t1, u, u1])
+        return p
+
+    # -------------------------------------------------------------- refinement
+    def _split_segment(self, b: int, c: int) -> bool:
+        """Split the boundary edge b→c (midpoint, or a power-of-two shell near a small angle)."""
+        t = self.bound.get((b, c))
+        if t is None:
+            return False
+        x, y = self.x, self.y
+        length = math.hypot(x[c] - x[b], y[c] - y[b])
+        if length < 1e3 * self.tol:
+            return False
+        frac = 0.5
+        # next to a small input angle, split on concentric shells (powers of two) around
+        # the apex so the refinement of the two segments meeting there cannot ping-pong
+        if b in self.small:
+            frac = 2.0 ** round(math.log2(length / 2.0)) / length
+        elif c in self.small:
+            frac = 1.0 - 2.0 ** round(math.log2(length / 2.0)) / length
+        px, py = x[b] + frac * (x[c] - x[b]), y[b] + frac * (y[c] - y[b])
+        k = next(k for k in range(3) if self.tri[t][k] not in (b, c))
+        seg = self.on_seg.get(b) or self.on_seg.get(c) or (b, c)
+        p = self.insert_on_edge(t, k, px, py)
+        self.on_seg[p] = seg
+        return True
+
+    def _encroached(self, t: int, k: int) -> bool:
+        """Boundary edge opposite vertex k of t lies under an obtuse apex (diametral circle)."""
+        tri = self.tri[t]
+        a, b, c = tri[k], tri[(k + 1) % 3], tri[(k + 2) % 3]
+        x, y = self.x, self.y
+        return (x[b] - x[a]) * (x[c] - x[a]) + (y[b] - y[a]) * (y[c] - y[a]) < 0.0
+
+    def _quality(self, t: int, sin_min: float, max_area: float) -> float:
+        """< 1 when the triangle is bad (too small an angle or too large)."""
+        a, b, c = self.tri[t]
+        x, y = self.x, self.y
+        l0 = math.hypot(x[b] - x[c], y[b] - y[c])
+        l1 = math.hypot(x[c] - x[a], y[c] - y[a])
+        l2 = math.hypot(x[a] - x[b], y[a] - y[b])
+        area2 = _orient2(x[a], y[a], x[b], y[b], x[c], y[c])
+        lmin = min(l0, l1, l2)
+        prod = l0 * l1 * l2 / lmin if lmin > 0 else math.inf
+        q = (area2 / prod) / sin_min if sin_min > 0 and prod > 0 else math.inf
+        if max_area > 0:
+            q = min(q, max_area / (0.5 * area2))
+        return q
+
+    def _area(self, t: int) -> float:
+        a, b, c = self.tri[t]
+        return 0.5 * self._orient(a, b, c)
+
+    def _unfixable(self, t: int) -> bool:
+        """A small angle squeezed between two input segments at a small input angle."""
+        tri, nb = self.tri[t], self.nbr[t]
+        x, y = self.x, self.y
+        best, kmin = math.inf, 0
+        for k in range(3):
+            a, b, c = tri[k], tri[(k + 1) % 3], tri[(k + 2) % 3]
+            ang = _angle(x[a], y[a], x[b], y[b], x[c], y[c])
+            if ang < best:
+                best, kmin = ang, k
+        v = tri[kmin]
+        if nb[(kmin + 1) % 3] < 0 and nb[(kmin + 2) % 3] < 0:
+            return True
+        if v in self.small:
+            others = [tri[(kmin + 1) % 3], tri[(kmin + 2) % 3]]
+            return all(o < self.n_input or v in self.on_seg.get(o, ()) for o in others)
+        return False
+
+    def _walk(self, t: int, px: float, py: float) -> tuple[int, int]:
+        """Walk from t towards p: (triangle, -1) containing p, or (triangle, k) blocked by boundary edge k."""
+        x, y = self.x, self.y
+        a, b, c = self.tri[t]
+        ox, oy = (x[a] + x[b] + x[c]) / 3.0, (y[a] + y[b] + y[c]) / 3.0
+        eps = self.tol * self.tol
+        for _ in range(4 * len(self.tri) + 10):
+            tri = self.tri[t]
+            exit_k = -1
+            for k in range(3):
+                v1, v2 = tri[(k + 1) % 3], tri[(k + 2) % 3]
+                if _orient2(x[v1], y[v1], x[v2], y[v2], px, py) < -eps:
+                    o1 = _orient2(ox, oy, px, py, x[v1], y[v1])
+                    o2 = _orient2(ox, oy, px, py, x[v2], y[v2])
+                    if o1 * o2 <= 0.0:
+                        exit_k = k
+                        break
+                    if exit_k < 0:
+                        exit_k = k + 3  # fallback when the walk line grazes a vertex
+            if exit_k < 0:
+                return t, -1
+            exit_k %= 3
+            u = self.nbr[t][exit_k]
+            if u < 0:
+                return t, exit_k
+            t = u
+        return t, -2
+
+    def _cavity_segments(self, t: int, px: float, py: float) -> list[tuple[int, int]]:
+        """Boundary edges of the triangles whose circumcircle holds p (those p may encroach)."""
+        x, y = self.x, self.y
+        seen, stack, segs = {t}, [t], []
+        q = self._new_vertex(px, py)
+        try:
+            while stack:
+                s = stack.pop()
+                tri, nb = self.tri[s], self.nbr[s]
+                for k in range(3):
+                    u = nb[k]
+                    if u < 0:
+                        segs.append((tri[(k + 1) % 3], tri[(k + 2) % 3]))
+                    elif u not in seen:
+                        ua, ub, uc = self.tri[u]
+                        if self._incircle(ua, ub, uc, q) > 1e-12:
+                            seen.add(u)
+                            stack.append(u)
+        finally:
+            self.x.pop()
+            self.y.pop()
+        out = []
+        for b, c in segs:
+            if (x[b] - px) * (x[c] - px) + (y[b] - py) * (y[c] - py) < 0.0:
+                out.append((b, c))
+        return out
+
+    def refine(self, min_angle: float | None, max_area: float | None, max_steiner: int) -> None:
+        """Ruppert's algorithm: split encroached segments, insert circumcentres of bad triangles."""
+        sin_min = math.sin(math.radians(min_angle)) if min_angle else 0.0
+        area_cap = max_area if max_area else 0.0
+        self.legalize_all()
+        segq: list[tuple[int, int]] = []
+        badq: list[tuple[float, int, tuple[int, ...]]] = []
+
+        def scan(ts: list[int]) -> None:
+            for t in dict.fromkeys(ts):
+                tri, nb = self.tri[t], self.nbr[t]
+                for k in range(3):
+                    if nb[k] < 0 and self._encroached(t, k):
+                        segq.append((tri[(k + 1) % 3], tri[(k + 2) % 3]))
+                q = self._quality(t, sin_min, area_cap)
+                if q < 1.0:
+                    heapq.heappush(badq, (q, t, tuple(tri)))
+
+        scan(list(range(len(self.tri))))
+        self.dirty = []
+        budget = max_steiner
+        retries: dict[tuple[int, ...], int] = {}
+        steps = 0
+        while budget > 0 and (segq or badq) and steps < 50 * max_steiner:
+            steps += 1
+            if segq:
+                b, c = segq.pop()
+                if self._split_segment(b, c):
+                    budget -= 1
+                    ts, self.dirty = self.dirty, []
+                    scan(ts)
+                continue
+            q, t, key = heapq.heappop(badq)
+            if tuple(self.tri[t]) != key:
+                continue
+            if not (area_cap and self._area(t) > area_cap) and self._unfixable(t):
+                continue
+            a, b, c = key
+            cx, cy = _circumcentre(self.x[a], self.y[a], self.x[b], self.y[b], self.x[c], self.y[c])
+            if not (math.isfinite(cx) and math.isfinite(cy)):
+                continue
+            s, k = self._walk(t, cx, cy)
+            if k == -2:
+                continue
+            if k >= 0:  # circumcentre beyond a wall: that wall segment is encroached
+                tri = self.tri[s]
+                enc = [(tri[(k + 1) % 3], tri[(k + 2) % 3])]
+            else:
+                enc = self._cavity_segments(s, cx, cy)
+            if enc:
+                # split the encroached walls instead, then try this triangle again (a few
+                # times only: a wall too short to split would otherwise loop for ever)
+                segq.extend(enc)
+                retries[key] = retries.get(key, 0) + 1
+                if retries[key] <= 3:
+                    heapq.heappush(badq, (q, t, key))
+                continue
+            self._insert_point(s, cx, cy)
+            budget -= 1
+            ts, self.dirty = self.dirty, []
+            scan(ts)
+
+    def _insert_point(self, t: int, px: float, py: float) -> None:
+        tri = self.tri[t]
+        x, y = self.x, self.y
+        for k in range(3):
+            v1, v2 = tri[(k + 1) % 3], tri[(k + 2) % 3]
+            el = math.hypot(x[v2] - x[v1], y[v2] - y[v1])
+            if abs(_orient2(x[v1], y[v1], x[v2], y[v2], px, py)) <= self.tol * el:
+                self.insert_on_edge(t, k, px, py)
+                return
+        self.insert_in_triangle(t, px, py)
+
+    def arrays(self) -> tuple[np.ndarray, np.ndarray]:
+        return np.column_stack([self.x, self.y]), np.asarray(self.tri, dtype=np.int64)
+
+
+def _angle(ax: float, ay: float, bx: float, by: float, cx: float, cy: float) -> float:
+    """Angle at a between rays a→b and a→c, in [0, π]."""
+    ux, uy, vx, vy = bx - ax, by - ay, cx - ax, cy - ay
+    return abs(math.atan2(ux * vy - uy * vx, ux * vx + uy * vy))
+
+
+def _circumcentre(ax: float, ay: float, bx: float, by: float, cx: float, cy: float) -> tuple[float, float]:
+    bx, by, cx, cy = bx - ax, by - ay, cx - ax, cy - ay
+    d = 2.0 * (bx * cy - by * cx)
+    if d == 0.0:
+        return math.nan, math.nan
+    b2, c2 = bx * bx + by * by, cx * cx + cy * cy
+    return ax + (cy * b2 - by * c2) / d, ay + (bx * c2 - cx * b2) / d
+
+def fix_degenerate(verts: np.ndarray, tris: np.ndarray, tol: float) -> np.ndarray:
+    """Remove zero-area triangles by flipping their long edge (earcut can emit them)."""
+    tris = orient_ccw(verts, tris)
+    ref = Refiner.__new__(Refiner)
+    ref.x, ref.y = verts[:, 0].tolist(), verts[:, 1].tolist()
+    ref.tri, ref.nbr = tris.tolist(), edge_neighbors(tris).tolist()
+    ref.tol, ref.dirty, ref.bound = tol, [], {}
+
+    def flat(t: int) -> bool:
+        a, b, c = ref.tri[t]
+        longest = max(math.hypot(ref.x[q] - ref.x[r], ref.y[q] - ref.y[r]) for q, r in ((b, c), (c, a), (a, b)))
+        return ref._orient(a, b, c) <= tol * longest
+
+    for _ in range(len(tris) + 1):
+        bad = next((t for t in range(len(ref.tri)) if flat(t)), None)
+        if bad is None:
+            break
+        a, b, c = ref.tri[bad]
+        # the vertex lying between the other two is opposite the long edge: flip that edge
+        lens = [math.hypot(ref.x[q] - ref.x[r], ref.y[q] - ref.y[r]) for q, r in ((b, c), (c, a), (a, b))]
+        k = int(np.argmax(lens))
+        if ref.nbr[bad][k] < 0:
+            raise ValueError("degenerate triangle on the boundary: a vertex lies on a wall")
+        ref._flip(bad, k)
+    return orient_ccw(verts, np.asarray(ref.tri, dtype=np.int64))

@@ -1,0 +1,390 @@
+"""Tiled maps as levels (SPEC §10 "Tiled maps").
+
+A Tiled JSON map (``.tmj``, or a ``.json`` whose ``"type"`` is ``"map"``) is read with
+pytiled-parser and converted into the level structure of SPEC §8, which
+:func:`navmesh.level.parse_level` then validates: both formats share every check, and a
+validation error is reported against the Tiled layer or object it came from.
+
+Conventions (documented for level designers in ``docs/levels.md``):
+
+* one tile is one world unit, or ``cell_size`` units if the map has that number property;
+  the grid is the map's tile grid;
+* blocked: every non-zero tile of a tile layer whose name or class is ``walls``, and every
+  object of class ``obstacle``; the outline is the map's bounds unless an ``outline``
+  object is given (an infinite map is cut to the bounds of its walls and obstacles, shifted
+  by whole tiles so that they start at the origin);
+* points (a point object, or the centre of any other shape): ``guard``, ``decoy``,
+  ``player``, ``collectible``; areas (rectangle, polygon, ellipse as a 32-gon, rotation
+  honoured): ``exit`` and every zone kind of :func:`navmesh.level.zone_kinds`.
+
+Object classes are matched on the object's ``class`` (Tiled >= 1.9) or legacy ``type``,
+case-insensitively; objects without a class are decoration and ignored, an unknown class
+is an error (a typo would otherwise silently drop a guard). Layer offsets count (those of
+enclosing groups added up); parallax, visibility and opacity are rendering matters and are
+ignored.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, NoReturn
+
+import numpy as np
+import pytiled_parser
+import shapely
+from pytiled_parser import layer as tl
+from pytiled_parser import tiled_object as to
+from shapely.geometry import Polygon, box
+
+from navmesh.level import Level, LevelError, parse_level, zone_kinds
+
+__all__ = ["ELLIPSE_SIDES", "load_tiled", "tiled_level_data"]
+
+ELLIPSE_SIDES = 32
+"""An ellipse object becomes this regular-angle polygon inscribed in it."""
+
+WALLS = "walls"
+"""Name or class of the tile layers whose non-zero tiles are blocked."""
+
+_POINT_CLASSES = {"guard": "guards", "decoy": "decoys", "collectible": "collectibles"}
+_SINGLE_POINT_CLASSES = ("player",)
+_SHAPE_CLASSES = ("obstacle", "outline", "exit")
+
+
+@dataclass
+class _Collected:
+    """What the layers hold, in map pixels (offsets applied), before conversion."""
+
+    walls: list[tuple[str, np.ndarray, np.ndarray, float, float]] = field(default_factory=list)
+    """(layer, tile columns, tile rows, offset x px, offset y px) of each walls layer."""
+    shapes: dict[str, list[tuple[str, Any]]] = field(default_factory=dict)
+    """class -> [(object description, shapely geometry in pixels)]."""
+
+
+def load_tiled(path: Path, source: str, digest: str | None = None) -> Level:
+    """Read a Tiled map and validate it as a level; errors name the Tiled layer or object.
+
+    ``digest`` is the content identity of the file (see :func:`navmesh.level.cached_level`).
+    """
+    data, origins = tiled_level_data(path, source)
+    try:
+        return parse_level(data, source, path=path, digest=digest)
+    except LevelError as exc:
+        raise LevelError(source, _origin(exc.field, origins), exc.problem) from None
+
+
+def tiled_level_data(path: Path, source: str) -> tuple[dict[str, Any], dict[str, str]]:
+    """The SPEC §8 level structure of a Tiled map, and where each of its entries came from.
+
+    The second value maps a field of the structure (``"guards[1]"``, ``"obstacles[0]"``,
+    ``"grid"``, ...) to the Tiled layer or object it was made from.
+    """
+    tmap = _read_map(path, source)
+    if tmap.orientation != "orthogonal":
+        _fail(source, "map", f"orientation {tmap.orientation!r} is not supported; "
+                             "only orthogonal maps are")
+    tile_w, tile_h = tmap.tile_size.width, tmap.tile_size.height
+    if tile_w != tile_h or tile_w <= 0:
+        _fail(source, "map", f"tiles of {tile_w}x{tile_h} pixels are not supported; "
+                             "tiles must be square")
+    cell_size = _cell_size(tmap, source)
+    found = _Collected()
+    _collect(tmap.layers, "", 0.0, 0.0, found, source)
+    tile = float(tile_w)
+
+    # Bounds in tiles: the map's, or for an infinite map those of its content.
+    outline_objects = found.shapes.get("outline", [])
+    if len(outline_objects) > 1:
+        _fail(source, outline_objects[1][0], "a second object of class 'outline'; "
+                                             "a map has at most one")
+    if not tmap.infinite:
+        x0, y0, x1, y1 = 0, 0, tmap.map_size.width, tmap.map_size.height
+    else:
+        x0, y0, x1, y1 = _content_bounds(found, outline_objects, tile, source)
+    shift = (x0 * tile, y0 * tile)  # pixels; whole tiles so the grid stays the tile grid
+    scale = cell_size / tile
+
+    def world(geometry: Any) -> Any:
+        return shapely.transform(geometry, lambda xy: (xy - shift) * scale)
+
+    data: dict[str, Any] = {"format": "stealth-level/1", "name": _name(tmap, path, source)}
+    data["cell_size"] = cell_size
+    origins: dict[str, str] = {}
+    aligned = all(ox % tile == 0 and oy % tile == 0 for _, _, _, ox, oy in found.walls)
+    obstacle_objects = found.shapes.get("obstacle", [])
+    walls_origin = ", ".join(f"layer {name!r}" for name, *_ in found.walls) or "map"
+    if aligned and not obstacle_objects and not outline_objects:
+        data["grid"] = _grid(found, (x0, y0, x1, y1), tile, source)
+        origins["grid"] = walls_origin
+    else:
+        if outline_objects:
+            where, outline = outline_objects[0]
+        else:
+            where, outline = "map bounds", box(x0 * tile, y0 * tile, x1 * tile, y1 * tile)
+        data["outline"] = _ring(world(outline))
+        origins["outline"] = where
+        obstacles: list[list[list[float]]] = []
+        for where, geometry in obstacle_objects:
+            origins[f"obstacles[{len(obstacles)}]"] = where
+            obstacles.append(_ring(world(geometry)))
+        for where, geometry in _wall_rectangles(found, outline, tile):
+            origins[f"obstacles[{len(obstacles)}]"] = where
+            obstacles.append(_ring(world(geometry)))
+        data["obstacles"] = obstacles
+        if not obstacles:
+            origins["obstacles"] = walls_origin
+
+    zones: dict[str, list[list[list[float]]]] = {}
+    for kind in zone_kinds():
+        for where, geometry in found.shapes.get(kind, []):
+            origins[f"zones.{kind}[{len(zones.setdefault(kind, []))}]"] = where
+            zones[kind].append(_ring(world(geometry)))
+    if zones:
+        data["zones"] = zones
+    for where, geometry in found.shapes.get("exit", []):
+        origins[f"exits[{len(data.setdefault('exits', []))}]"] = where
+        data["exits"].append(_ring(world(geometry)))
+    for cls, key in _POINT_CLASSES.items():
+        points = data.setdefault(key, []) if cls == "guard" else data.get(key, [])
+        for where, geometry in found.shapes.get(cls, []):
+            origins[f"{key}[{len(points)}]"] = where
+            points.append(_xy(world(geometry)))
+        if points:
+            data[key] = points
+    origins["guards"] = "objects of class 'guard'"
+    players = found.shapes.get("player", [])
+    if len(players) > 1:
+        _fail(source, players[1][0], "a second object of class 'player'; a map has at most one")
+    if players:
+        origins["player"] = players[0][0]
+        data["player"] = _xy(world(players[0][1]))
+    return data, origins
+
+
+# --------------------------------------------------------------------------- reading
+
+
+def _read_map(path: Path, source: str) -> pytiled_parser.TiledMap:
+    """Parse with pytiled-parser; any failure of it becomes a one-line LevelError.
+
+    The reader signals malformed input with whatever its code happens to raise (KeyError for
+    a missing key, TypeError, ValueError, NotImplementedError for TMX templates, OSError for
+    a missing tileset file, ...), so everything it raises is caught here and reported with
+    its type: the map is user input and must never end in a traceback.
+    """
+    try:
+        return pytiled_parser.parse_map(path)
+    except KeyError as exc:
+        _fail(source, "map", f"not a Tiled map Stealthfield can read: missing key {exc}")
+    except FileNotFoundError as exc:
+        _fail(source, "map", f"a file the map refers to is missing: {exc.filename}")
+    except Exception as exc:  # noqa: BLE001 - third-party reader, see the docstring
+        _fail(source, "map", f"not a Tiled map Stealthfield can read: "
+                             f"{type(exc).__name__}: {exc}")
+
+
+def _cell_size(tmap: pytiled_parser.TiledMap, source: str) -> float:
+    value = (tmap.properties or {}).get("cell_size", 1.0)
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        _fail(source, "map property cell_size", f"expected a number, got {value!r}")
+    if not (math.isfinite(value) and value > 0):
+        _fail(source, "map property cell_size", f"must be a finite number > 0, got {value!r}")
+    return float(value)
+
+
+def _name(tmap: pytiled_parser.TiledMap, path: Path, source: str) -> str:
+    """The map's string property ``name``, else the file's stem."""
+    value = (tmap.properties or {}).get("name", path.stem)
+    if not isinstance(value, str):
+        _fail(source, "map property name", f"expected a string, got {value!r}")
+    return value
+
+
+def _class_of(thing: Any) -> str:
+    return (getattr(thing, "class_", None) or "").strip().lower()
+
+
+def _collect(
+    layers: list[tl.Layer], parent: str, ox: float, oy: float, found: _Collected, src: str
+) -> None:
+    """Walk the layer tree, adding up group offsets, into ``found``."""
+    for layer in layers:
+        name = f"{parent}{layer.name}"
+        lx, ly = ox + float(layer.offset.x), oy + float(layer.offset.y)
+        if isinstance(layer, tl.LayerGroup):
+            _collect(layer.layers, f"{name}/", lx, ly, found, src)
+        elif isinstance(layer, tl.TileLayer):
+            if WALLS in (layer.name.strip().lower(), _class_of(layer)):
+                cols, rows = _nonzero_tiles(layer, name, src)
+                found.walls.append((name, cols, rows, lx, ly))
+        elif isinstance(layer, tl.ObjectLayer):
+            for obj in layer.tiled_objects:
+                _collect_object(obj, name, lx, ly, found, src)
+        # image layers are pictures only
+
+
+def _nonzero_tiles(layer: tl.TileLayer, name: str, src: str) -> tuple[np.ndarray, np.ndarray]:
+    """Tile columns and rows (layer coordinates) of the layer's non-zero gids."""
+    blocks = [(0, 0, layer.data)] if layer.data is not None else []
+    blocks += [(c.coordinates.x, c.coordinates.y, c.data) for c in layer.chunks or []]
+    cols, rows = [], []
+    for x0, y0, data in blocks:
+        for r, row in enumerate(data):
+            c = np.flatnonzero(np.asarray(row, dtype=np.int64))
+            cols.append(c + int(x0))
+            rows.append(np.full(c.size, r + int(y0)))
+    if not cols:
+        _fail(src, f"layer {name!r}", "walls layer has no tile data")
+    return np.concatenate(cols), np.concatenate(rows)
+
+
+def _describe_object(obj: to.TiledObject, layer: str, cls: str) -> str:
+    named = f" {obj.name!r}" if obj.name else ""
+    return f"layer {layer!r} object {obj.id}{named} ({cls})"
+
+
+def _collect_object(
+    obj: to.TiledObject, layer: str, ox: float, oy: float, found: _Collected, src: str
+) -> None:
+    cls = _class_of(obj)
+    if not cls:
+        return  # decoration
+    where = _describe_object(obj, layer, cls)
+    areas = (*_SHAPE_CLASSES, *zone_kinds())
+    points = (*_POINT_CLASSES, *_SINGLE_POINT_CLASSES)
+    if cls not in areas and cls not in points:
+        known = ", ".join((*points, *areas))
+        _fail(src, where, f"unknown class {obj.class_!r} (known classes: {known}; "
+                          "leave the class empty for decoration)")
+    geometry = _object_geometry(obj, ox, oy, where, src, want_area=cls in areas)
+    found.shapes.setdefault(cls, []).append((where, geometry))
+
+
+def _object_geometry(
+    obj: to.TiledObject, ox: float, oy: float, where: str, src: str, *, want_area: bool
+) -> Any:
+    """The object's shape in map pixels: a polygon, or a point for a point object."""
+    if isinstance(obj, to.Tile):
+        _fail(src, where, "tile objects have no shape; use a point, rectangle, polygon or "
+                          "ellipse object")
+    if isinstance(obj, to.Text):
+        _fail(src, where, "text objects have no shape; use a point, rectangle, polygon or "
+                          "ellipse object")
+    if isinstance(obj, to.Polyline):
+        _fail(src, where, "a polyline is not closed; use a polygon object")
+    x, y = float(obj.coordinates.x) + ox, float(obj.coordinates.y) + oy
+    if isinstance(obj, to.Point):
+        if want_area:
+            _fail(src, where, "a point object has no area; use a rectangle, polygon or ellipse")
+        return shapely.Point(x, y)
+    w, h = float(obj.size.width), float(obj.size.height)
+    if isinstance(obj, to.Polygon):
+        local = np.array([(float(p.x), float(p.y)) for p in obj.points])
+    elif isinstance(obj, to.Ellipse):
+        angles = 2.0 * np.pi * np.arange(ELLIPSE_SIDES) / ELLIPSE_SIDES
+        local = np.column_stack([w / 2 * (1 + np.cos(angles)), h / 2 * (1 + np.sin(angles))])
+    elif isinstance(obj, to.Rectangle):
+        local = np.array([(0.0, 0.0), (w, 0.0), (w, h), (0.0, h)])
+    else:  # pragma: no cover - pytiled-parser has no other object kinds
+        _fail(src, where, f"unsupported object kind {type(obj).__name__}")
+    if not isinstance(obj, to.Polygon) and (w <= 0 or h <= 0):
+        if want_area:
+            _fail(src, where, f"shape of {w:g}x{h:g} pixels has no area")
+        return shapely.Point(x, y)  # a zero-size rectangle is how older Tiled wrote points
+    if len(local) < 3:
+        _fail(src, where, f"polygon needs at least 3 points, got {len(local)}")
+    theta = math.radians(float(obj.rotation))  # degrees clockwise on screen, about (x, y)
+    cos, sin = math.cos(theta), math.sin(theta)
+    if theta:
+        local = local @ np.array([[cos, sin], [-sin, cos]])
+    polygon = Polygon(local + (x, y))
+    if not want_area:
+        if not polygon.is_valid or polygon.area <= 0:
+            _fail(src, where, "shape is not a simple polygon, so it has no centre")
+        return polygon.centroid
+    return polygon
+
+
+# --------------------------------------------------------------------------- converting
+
+
+def _wall_tiles(found: _Collected, tile: float) -> tuple[np.ndarray, np.ndarray]:
+    """Tile-aligned wall cells of all walls layers (their offsets are whole tiles)."""
+    cols = [c + int(ox // tile) for _, c, _, ox, _ in found.walls]
+    rows = [r + int(oy // tile) for _, _, r, _, oy in found.walls]
+    return np.concatenate(cols or [np.zeros(0, int)]), np.concatenate(rows or [np.zeros(0, int)])
+
+
+def _content_bounds(
+    found: _Collected, outline_objects: list[tuple[str, Any]], tile: float, src: str
+) -> tuple[int, int, int, int]:
+    """Whole-tile bounds of an infinite map: its outline, else its walls and obstacles."""
+    if outline_objects:
+        minx, miny, maxx, maxy = outline_objects[0][1].bounds
+    else:
+        boxes = [g.bounds for _, g in found.shapes.get("obstacle", [])]
+        for _, c, r, ox, oy in found.walls:
+            if c.size:
+                boxes.append((c.min() * tile + ox, r.min() * tile + oy,
+                              (c.max() + 1) * tile + ox, (r.max() + 1) * tile + oy))
+        if not boxes:
+            _fail(src, "map", "an infinite map needs a walls tile layer, obstacle objects or "
+                              "an outline object to tell its extent")
+        minx, miny = min(b[0] for b in boxes), min(b[1] for b in boxes)
+        maxx, maxy = max(b[2] for b in boxes), max(b[3] for b in boxes)
+    return (math.floor(minx / tile), math.floor(miny / tile),
+            math.ceil(maxx / tile), math.ceil(maxy / tile))
+
+
+def _grid(found: _Collected, bounds: tuple[int, int, int, int], tile: float, src: str
+          ) -> list[str]:
+    """Grid strings over ``bounds`` (tiles): ``#`` where any walls layer has a tile."""
+    x0, y0, x1, y1 = bounds
+    if x1 <= x0 or y1 <= y0:
+        _fail(src, "map", f"map of {x1 - x0}x{y1 - y0} tiles is empty")
+    blocked = np.zeros((y1 - y0, x1 - x0), dtype=bool)
+    cols, rows = _wall_tiles(found, tile)
+    inside = (cols >= x0) & (cols < x1) & (rows >= y0) & (rows < y1)
+    blocked[rows[inside] - y0, cols[inside] - x0] = True
+    return ["".join(row) for row in np.where(blocked, "#", ".").tolist()]
+
+
+def _wall_rectangles(
+    found: _Collected, outline: Polygon, tile: float
+) -> list[tuple[str, Polygon]]:
+    """Each walls layer's tiles as rectangles (runs along a row), those touching the outline."""
+    rectangles = []
+    for name, cols, rows, ox, oy in found.walls:
+        if not cols.size:
+            continue
+        order = np.lexsort((cols, rows))
+        c, r = cols[order], rows[order]
+        starts = np.flatnonzero(np.r_[True, (np.diff(c) != 1) | (np.diff(r) != 0)])
+        ends = np.r_[starts[1:], c.size] - 1
+        for s, e in zip(starts, ends):
+            rect = box(c[s] * tile + ox, r[s] * tile + oy,
+                       (c[e] + 1) * tile + ox, (r[s] + 1) * tile + oy)
+            if outline.intersection(rect).area > 0:
+                rectangles.append((f"layer {name!r}", rect))
+    return rectangles
+
+
+def _ring(polygon: Polygon) -> list[list[float]]:
+    return [[float(x), float(y)] for x, y in polygon.exterior.coords[:-1]]
+
+
+def _xy(point: Any) -> list[float]:
+    return [float(point.x), float(point.y)]
+
+
+def _origin(fld: str, origins: dict[str, str]) -> str:
+    """The Tiled layer or object behind a field of the converted structure."""
+    best = max((k for k in origins if fld == k or fld.startswith(k + "[")
+                or fld.startswith(k + ".")), key=len, default=None)
+    return origins[best] if best is not None else fld
+
+
+def _fail(src: str, fld: str, problem: str) -> NoReturn:
+    raise LevelError(src, fld, problem)

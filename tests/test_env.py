@@ -1,0 +1,197 @@
+"""The RL environments (game/env.py): API conformance, seeding, step semantics, rendering."""
+
+from __future__ import annotations
+
+import math
+import os
+import subprocess
+import sys
+import warnings
+
+import numpy as np
+import pytest
+
+gymnasium = pytest.importorskip("gymnasium")  # the `test` extra installs both
+pytest.importorskip("pettingzoo")
+
+from gymnasium.utils.env_checker import check_env  # noqa: E402
+from pettingzoo.test import parallel_api_test, parallel_seed_test  # noqa: E402
+
+from game.env import ENV_ID, StealthEnv, parallel_env  # noqa: E402
+from game.trial import TrialSpec, make_world  # noqa: E402
+
+ABSTRACTIONS = ("grid", "partition")
+
+
+@pytest.mark.parametrize("abstraction", ABSTRACTIONS)
+def test_pettingzoo_parallel_api(abstraction: str) -> None:
+    env = parallel_env("maze", abstraction, world__duration=8.0)
+    parallel_api_test(env, num_cycles=40)
+
+
+@pytest.mark.parametrize("abstraction", ABSTRACTIONS)
+def test_pettingzoo_seed(abstraction: str) -> None:
+    parallel_seed_test(lambda: parallel_env("maze", abstraction, world__duration=8.0),
+                       num_cycles=30)
+
+
+@pytest.mark.parametrize("abstraction", ABSTRACTIONS)
+def test_gymnasium_check_env(abstraction: str) -> None:
+    env = StealthEnv("maze", abstraction=abstraction, world__duration=8.0)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # a checker warning is a failure here
+        check_env(env, skip_render_check=True)
+
+
+def test_registered_with_gymnasium() -> None:
+    env = gymnasium.make(ENV_ID, level="maze", guards="fsm", world__duration=4.0)
+    obs, info = env.reset(seed=5)
+    assert env.observation_space.contains(obs) and info["seed"] == 5
+
+
+def test_spaces_follow_the_abstraction() -> None:
+    assert StealthEnv("maze").action_space.n == 5
+    assert StealthEnv("maze", abstraction="partition").action_space.n == 9
+    env = parallel_env("maze", world__guards=2, obs_radius=2)
+    assert env.possible_agents == ["player", "guard_0", "guard_1"]
+    # player: 3 channels of 5x5, 7 own features, 5 per guard; guards: 5 channels, 7, 5 each, 3
+    assert env.observation_space("player").shape == (3 * 25 + 7 + 2 * 5,)
+    assert env.observation_space("guard_1").shape == (5 * 25 + 7 + 2 * 5 + 3,)
+
+
+def _rollout(env: StealthEnv, seed: int, actions: np.ndarray) -> tuple[list, list]:
+    obs, _ = env.reset(seed=seed)
+    seen, rewards = [obs], []
+    for a in actions:
+        obs, r, term, trunc, _ = env.step(int(a))
+        seen.append(obs)
+        rewards.append(r)
+        if term or trunc:
+            break
+    return seen, rewards
+
+
+@pytest.mark.parametrize("abstraction", ABSTRACTIONS)
+def test_same_seed_same_episode(abstraction: str) -> None:
+    actions = np.random.default_rng(7).integers(0, 9 if abstraction == "partition" else 5, 60)
+    a = _rollout(StealthEnv("maze", abstraction=abstraction), 11, actions)
+    b = _rollout(StealthEnv("maze", abstraction=abstraction), 11, actions)
+    assert len(a[0]) == len(b[0])
+    assert all(np.array_equal(x, y) for x, y in zip(a[0], b[0], strict=True))
+    assert a[1] == b[1]
+    c = _rollout(StealthEnv("maze", abstraction=abstraction), 12, actions)
+    assert len(a[0]) != len(c[0]) or any(  # another seed, another episode
+        not np.array_equal(x, y) for x, y in zip(a[0], c[0], strict=True))
+
+
+def test_seedless_resets_continue_from_the_seed() -> None:
+    env = StealthEnv("maze", world__duration=2.0)
+    env.reset(seed=20)
+    assert env.reset()[1]["seed"] == 21
+    assert env.reset()[1]["seed"] == 22
+
+
+def test_episode_starts_where_the_trial_of_that_seed_starts() -> None:
+    """Spawns come from the trial's spawn generator: same guards and player start."""
+    env = StealthEnv("maze", guards="pf")
+    for seed in (0, 4):
+        env.reset(seed=seed)
+        trial = make_world(TrialSpec("maze", "grid", "pf", "maxmin", "capture", seed))
+        assert env.match.world.player.pos == trial.player.pos
+        assert [g.pos for g in env.match.world.guards] == [g.pos for g in trial.guards]
+        assert [g.heading for g in env.match.world.guards] == [g.heading for g in trial.guards]
+
+
+def test_a_grid_step_is_one_cell_and_stay_stays() -> None:
+    env = StealthEnv("maze", guards="random", world__player_hp=1e6)  # never captured
+    env.reset(seed=2)
+    world = env.match.world
+    moves = env.match.moves
+    moved = 0
+    for action in (1, 2, 3, 4, 0):
+        start, before_t = world.player.node, world.t
+        _, reward, *_ = env.step(action)
+        expected = moves[start, action]
+        assert world.player.node == expected
+        assert np.allclose(world.player.pos, world.graph.positions[expected])
+        if expected != start:
+            moved += 1
+            # one cell at 2.4 cells/s (capture scenario) takes 9 physics steps of 0.05 s
+            assert math.isclose(world.t - before_t, 0.45)
+        else:
+            assert math.isclose(world.t - before_t, env.match.hold_steps * 0.05)
+        assert math.isclose(reward, 0.1 * (world.t - before_t))  # survival only
+    assert moved >= 2
+
+
+def test_capture_ends_the_episode_with_the_penalty() -> None:
+    env = StealthEnv("maze", guards="cheat", world__guards=3)
+    env.reset(seed=0)
+    total, term, trunc, info = 0.0, False, False, {}
+    while not (term or trunc):
+        _, r, term, trunc, info = env.step(0)  # a player that never moves
+        total += r
+    assert term and not trunc and info["captures"] == 1 and info["hp"] <= 0
+    assert math.isclose(total, 0.1 * info["t"] - 3.0 - 10.0, abs_tol=1e-6)
+
+
+def test_guard_agents_move_as_told_and_see_fields() -> None:
+    env = parallel_env("maze", world__guards=2)
+    obs, _ = env.reset(seed=3)
+    world = env.match.world
+    moves = env.match.moves
+    guard_nodes = [g.node for g in world.guards]
+    # the guards decide at their first arrival, which is the first physics step
+    env.step({"player": 0, "guard_0": 2, "guard_1": 3})
+    targets = [g.target for g in world.guards]
+    assert targets == [moves[guard_nodes[0], 2], moves[guard_nodes[1], 3]]
+    for _ in range(6):
+        obs, rewards, *_ = env.step({"player": 0, "guard_0": 1, "guard_1": 4})
+        assert rewards["guard_0"] == -rewards["player"]
+    side = (2 * env.match.radius + 1) ** 2
+    confidence = obs["guard_0"][4 * side:5 * side]
+    assert confidence.max() > 0  # the team's confidence field is observed
+
+
+@pytest.mark.parametrize("abstraction", ABSTRACTIONS)
+def test_rgb_array_render(abstraction: str) -> None:
+    env = StealthEnv("maze", abstraction=abstraction, render_mode="rgb_array",
+                     render_size=(320, 280))
+    env.reset(seed=1)
+    frame = env.render()
+    assert frame.shape == (280, 320, 3) and frame.dtype == np.uint8
+    assert len(np.unique(frame.reshape(-1, 3), axis=0)) > 5  # a real picture, not a blank
+    env.step(1)
+    assert env.render().shape == frame.shape  # the cached renderer draws the next frame
+    penv = parallel_env("maze", render_mode="rgb_array", render_size=(200, 200))
+    penv.reset(seed=0)
+    assert penv.render().shape == (200, 200, 3)
+
+
+def test_no_pygame_without_rendering() -> None:
+    code = ("import sys, game.env as e; env = e.StealthEnv('maze'); env.reset(seed=0); "
+            "env.step(1); print('pygame' in sys.modules)")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                         env={**os.environ}, check=True)
+    assert out.stdout.strip() == "False"
+
+
+def test_bad_options_are_clear() -> None:
+    with pytest.raises(ValueError, match="abstraction"):
+        StealthEnv("maze", abstraction="hex")
+    with pytest.raises(ValueError, match="render_mode"):
+        StealthEnv("maze", render_mode="ascii")
+    with pytest.raises(ValueError, match="unknown config key"):
+        StealthEnv("maze", world__gards=2)
+
+
+def test_fixed_time_capture_respawns_and_counts_the_penalty() -> None:
+    env = StealthEnv("maze", guards="cheat", scenario="fixed", world__duration=20.0)
+    env.reset(seed=0)
+    total, term, trunc, info = 0.0, False, False, {}
+    while not (term or trunc):
+        _, r, term, trunc, info = env.step(0)
+        total += r
+    assert not term and trunc and info["captures"] >= 1 and math.isclose(info["t"], 20.0)
+    lost = 3.0 * info["captures"] + (3.0 - info["hp"])
+    assert math.isclose(total, 0.1 * 20.0 - lost - 10.0 * info["captures"], abs_tol=1e-6)
