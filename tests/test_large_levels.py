@@ -54,3 +54,18 @@ def test_trials_do_not_depend_on_the_graph_storage(
     for a, b in zip(dense, searched, strict=True):
         a.pop("wall_time"), b.pop("wall_time")
         assert a == b
+
+
+def test_a_level_too_big_for_the_machine_is_refused_in_one_line(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    from navmesh.level import LevelError, load_level
+
+    level = load_level("maze")
+    graph_module.check_fits(level, "maze")  # fits
+    monkeypatch.setattr(graph_module, "available_bytes", lambda: 2**20)
+    with pytest.raises(LevelError) as error:
+        graph_module.check_fits(level, "maze")
+    message = str(error.value)
+    assert message.startswith("maze: size: 20x20 cells, about 206 nodes: needs about")
+    assert "\n" not in message and "GB available" in message
