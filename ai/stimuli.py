@@ -43,15 +43,12 @@ import numpy as np
 
 from navmesh.graph import UNREACHABLE_HOPS, NodeGraph
 
+from .errors import StimulusError
 from .params import _NON_NEGATIVE, _POSITIVE, _UNIT, _Params
 from .view import Event, WorldView
 
 #: importlib.metadata entry-point group under which installed packages register stimuli
 ENTRY_POINT_GROUP = "stealthfield.stimuli"
-
-
-class StimulusError(ValueError):
-    """A stimulus plugin that cannot be loaded; the message is one line naming it."""
 
 
 # ---------------------------------------------------------------------------- parameters

@@ -32,6 +32,7 @@ import numpy as np
 import shapely
 from shapely.geometry import Polygon
 
+from navmesh.errors import OutsideError
 from navmesh.funnel import funnel
 from navmesh.visibility import MeshSight, polygon_rings
 
@@ -44,10 +45,6 @@ DEFAULT_MIN_ANGLE = 20.0
 #: Above this many wall corners the exact-path tables are not built (A* + funnel instead).
 MAX_CORNERS = 1000
 _MAX_MIN_ANGLE = 34.0  # Ruppert's refinement is only guaranteed to stop below ~33.8 degrees
-
-
-class OutsideError(ValueError):
-    """A query point lies outside the walkable area."""
 
 
 @dataclass
