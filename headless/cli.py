@@ -250,6 +250,7 @@ def _version() -> str:
 def build_parser() -> argparse.ArgumentParser:
     """The ``stealth`` parser; its choices come from the registries and name constants."""
     from game.front.keys import key_table
+    from game.scene import OVERLAYS
     from game.world import SCENARIOS
 
     modes, policies = list(GUARD_MODES), list(PLAYER_POLICIES)
@@ -355,7 +356,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--screenshot", default=None, metavar="FILE.png",
                    help="save the last frame as PNG (default: none)")
     p.add_argument("--overlay", default="none",
-                   help="initial field overlay: none, I, C, N, P or K")
+                   help=f"initial field overlay: {', '.join(OVERLAYS)}")
     p.add_argument("--seed", type=int, default=0, help="seed of the guards' decisions")
     add_set(p)
     p.add_argument("--scenario", choices=scenarios, default="capture",

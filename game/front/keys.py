@@ -24,7 +24,7 @@ KEY_HELP: tuple[tuple[str, str], ...] = (
     ("F", "take down the guard in reach (leaves a corpse)"),
     ("R", "toggle rain"),
     ("Space", "pause"),
-    ("O / Tab", "next field overlay (none, I, C, N, P, K)"),
+    ("O / Tab", "next field overlay (none, I, C, N, P, K, ...)"),
     ("M", "show the grid / navmesh"),
     ("G", "show the guards' plans"),
     (f"1-{len(MODE_ORDER)}", "restart with guards " + "/".join(MODE_ORDER)),

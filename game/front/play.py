@@ -189,7 +189,8 @@ class PlayGame(FrameLoop):
         elif key == pygame.K_SPACE:
             self.paused = not self.paused
         elif key in (pygame.K_o, pygame.K_TAB):
-            self.overlay = OVERLAYS[(OVERLAYS.index(self.overlay) + 1) % len(OVERLAYS)]
+            keys = list(OVERLAYS)
+            self.overlay = keys[(keys.index(self.overlay) + 1) % len(keys)]
         elif key == pygame.K_m:
             self.show_mesh = not self.show_mesh
         elif key == pygame.K_g:
