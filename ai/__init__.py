@@ -45,7 +45,7 @@ class Registration(Generic[T]):
         if isinstance(factory, str):
             module, _, attr = factory.partition(":")
             factory = getattr(import_module(module), attr)
-        return factory(params)  # type: ignore[operator,no-any-return]
+        return factory(params)
 
 
 #: Registered guard modes by command-line name (SPEC §9 order).

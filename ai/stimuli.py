@@ -278,8 +278,8 @@ class Noise(Stimulus):
     def start(self, ctx: FieldContext) -> None:
         self.shape = ctx.falloff(self.node, self.falloff, self.max_hops)
 
-    def inject(self, ctx: FieldContext) -> np.ndarray:
-        return -self.level * self.shape
+    def inject(self, ctx: FieldContext) -> np.ndarray | None:
+        return None if self.shape is None else -self.level * self.shape
 
     def decay(self, dt: float) -> None:
         self.level *= self.rate**dt
@@ -314,7 +314,7 @@ class StaticDecoy(Stimulus):
     def start(self, ctx: FieldContext) -> None:
         self.layer = -self.amplitude * ctx.falloff(self.node, self.falloff)
 
-    def inject(self, ctx: FieldContext) -> np.ndarray:
+    def inject(self, ctx: FieldContext) -> np.ndarray | None:
         return self.layer
 
     def on_tick(self, view: WorldView, dt: float) -> None:
@@ -360,8 +360,8 @@ class Corpse(Stimulus):
     def start(self, ctx: FieldContext) -> None:
         self.shape = ctx.falloff(self.node, self.falloff)
 
-    def inject(self, ctx: FieldContext) -> np.ndarray:
-        return -self.level * self.shape
+    def inject(self, ctx: FieldContext) -> np.ndarray | None:
+        return None if self.shape is None else -self.level * self.shape
 
     def decay(self, dt: float) -> None:
         self.level *= self.rate**dt
@@ -624,7 +624,7 @@ def zones_from_config(section: Mapping[str, Any]) -> dict[str, Zone]:
         for suffix in ("_confidence_decay", "_view_scale"):
             if key.endswith(suffix):
                 kinds.setdefault(key[: -len(suffix)], {})[suffix[1:]] = float(value)
-    return {kind: Zone(kind, **values) for kind, values in kinds.items()}  # type: ignore[arg-type]
+    return {kind: Zone(kind, **values) for kind, values in kinds.items()}
 
 
 def zone_view_scale(zones: Mapping[str, Zone], masks: Mapping[str, np.ndarray], n: int) -> np.ndarray:
@@ -642,9 +642,12 @@ def apply_zones(guard_ai: GuardAI, zones: Mapping[str, Zone], masks: Mapping[str
 
     Slowest rates first, so where zones overlap the fastest decay wins.
     """
-    rules = [(zones[k].confidence_decay, m) for k, m in masks.items()
-             if k in zones and zones[k].confidence_decay is not None and np.any(m)]
-    for rate, mask in sorted(rules, key=lambda item: -item[0]):  # type: ignore[operator]
+    rules: list[tuple[float, np.ndarray]] = []
+    for kind, mask in masks.items():
+        rate = zones[kind].confidence_decay if kind in zones else None
+        if rate is not None and np.any(mask):
+            rules.append((rate, mask))
+    for rate, mask in sorted(rules, key=lambda item: -item[0]):
         guard_ai.set_confidence_decay(np.asarray(mask, dtype=bool), rate)
 
 

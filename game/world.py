@@ -119,10 +119,9 @@ class Metrics:
 class World:
     """One trial of one level, abstraction, guard team, player policy, scenario and seed.
 
-    >>> # doctest: +SKIP
-    >>> world = World(load_level("maze"), "grid", make_guard_ai("cheat"),
+    >>> world = World(load_level("maze"), "grid", make_guard_ai("cheat"),  # doctest: +SKIP
     ...               make_player_policy("evade"), config=Config.defaults(), seed=1)
-    >>> while not world.done: world.step()
+    >>> while not world.done: world.step()  # doctest: +SKIP
     """
 
     def __init__(

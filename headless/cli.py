@@ -41,11 +41,19 @@ def _emit_json(document: Any) -> None:
 
 
 # ---------------------------------------------------------------------- levels / validate
-def level_stats(level: Any) -> dict[str, Any]:
-    """Paper Table 1 for one level: navmesh triangles and areas, grid size and counts."""
+def _navmesh(level: Any) -> Any:
+    """The level's navmesh (the partition graph's, cached per process)."""
     from navmesh.graph import graph_for
 
     mesh = graph_for(level, "partition").mesh
+    if mesh is None:  # pragma: no cover - a partition graph always has its mesh
+        raise RuntimeError(f"level {level.name}: the partition graph has no navmesh")
+    return mesh
+
+
+def level_stats(level: Any) -> dict[str, Any]:
+    """Paper Table 1 for one level: navmesh triangles and areas, grid size and counts."""
+    mesh = _navmesh(level)
     walkable = int(level.occupancy.sum())
     return {
         "name": level.name,
@@ -101,19 +109,15 @@ def cmd_validate(args: argparse.Namespace) -> int:
 
 # ---------------------------------------------------------------------- path
 def cmd_path(args: argparse.Namespace) -> int:
-    from navmesh.graph import graph_for
     from navmesh.level import load_level
 
-    level = load_level(args.level)
-    mesh = graph_for(level, "partition").mesh
-    path = mesh.find_path(args.from_, args.to)
-    document = {"points": [[float(x), float(y)] for x, y in path.points],
-                "length": float(path.length)}
+    path = _navmesh(load_level(args.level)).find_path(args.from_, args.to)
+    points = [[float(x), float(y)] for x, y in path.points]
     if args.json:
-        _emit_json(document)
+        _emit_json({"points": points, "length": float(path.length)})
     else:
-        print(f"length {document['length']:.4f} through {len(path.points)} points")
-        for x, y in document["points"]:
+        print(f"length {float(path.length):.4f} through {len(points)} points")
+        for x, y in points:
             print(f"  {x:.4f},{y:.4f}")
     return 0
 

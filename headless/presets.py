@@ -256,8 +256,8 @@ def parse_preset(
                                        f"({type(error).__name__}: {error})") from None
     for policy in players:
         try:
-            registration = player_policy(policy)
-            registration.build(config.section(registration.section))
+            policy_registration = player_policy(policy)
+            policy_registration.build(config.section(policy_registration.section))
         except Exception as error:
             raise _fail(src, "players", f"{policy}: cannot be loaded "
                                         f"({type(error).__name__}: {error})") from None

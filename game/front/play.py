@@ -84,9 +84,8 @@ class PlayGame(FrameLoop):
     ``lockstep=True`` advances exactly one physics step per :meth:`frame`; otherwise the
     world follows the wall clock.
 
-    >>> # doctest: +SKIP
-    >>> game = PlayGame(PlaySettings("miami", autopilot="maxmin", overlay="K"), lockstep=True)
-    >>> times = game.run(frames=120)
+    >>> game = PlayGame(PlaySettings("miami", autopilot="maxmin", overlay="K"), lockstep=True)  # doctest: +SKIP
+    >>> times = game.run(frames=120)  # doctest: +SKIP
     """
 
     def __init__(
