@@ -23,7 +23,6 @@ Only rendering imports pygame (``game.front``), inside :meth:`_Match.render`.
 from __future__ import annotations
 
 import math
-import os
 from collections.abc import Mapping
 from typing import Any
 
@@ -162,6 +161,13 @@ class ExternalGuards(PotentialFieldGuards):
 
 
 # ---------------------------------------------------------------------------- the match
+
+
+def _active(view: WorldView) -> np.ndarray:
+    """Which guards are in play (all of them when the view does not say)."""
+    if view.guard_active is None:
+        return np.ones(len(view.guard_nodes), dtype=bool)
+    return view.guard_active
 
 
 def _split_options(level: str, abstraction: str, scenario: str, kwargs: dict[str, Any]
@@ -333,7 +339,7 @@ class _Match:
     def player_sees(self, view: WorldView, j: int) -> bool:
         """The player perceives guard ``j`` within view range with a clear line (no cone)."""
         a, b = view.player_pos, view.guard_positions[j]
-        if not view.guard_active[j] or math.dist(a, b) > self.view_range:
+        if not _active(view)[j] or math.dist(a, b) > self.view_range:
             return False
         return math.dist(a, b) < 1e-9 or bool(self.walkable.covers(LineString([a, b])))
 
@@ -374,7 +380,7 @@ class _Match:
         if team_sees:
             self._mark(win, 1, row, col, view.player_pos)
         for j in range(self.n_guards):
-            if view.guard_active[j]:
+            if _active(view)[j]:
                 self._mark(win, 2, row, col, view.guard_positions[j])
         if self.guards is not None:
             fields = self.guards.fields()
@@ -387,7 +393,7 @@ class _Match:
             win[4][inside] = np.asarray(fields["C"])[nodes[inside]] / c_scale
         vec = self._self_features(pos, float(view.guard_headings[i]), view)
         vec += [float(i in view.seen_by)]
-        vec += self._guard_features(view, pos, [bool(a) for a in view.guard_active])
+        vec += self._guard_features(view, pos, [bool(a) for a in _active(view)])
         d = (view.player_pos - pos) / self.diagonal
         vec += [1.0, d[0], d[1]] if team_sees else [0.0, 0.0, 0.0]
         return self._pack(win, vec)
@@ -412,42 +418,20 @@ class _Match:
         """Draw the world with the game's renderer: an RGB array, or into a window."""
         if self.render_mode is None:
             return None
-        if self.render_mode == "rgb_array":
-            os.environ.setdefault("SDL_VIDEODRIVER", "dummy")  # no window for an array
-        import pygame  # noqa: PLC0415 — rendering only
-
-        from game.front.render import (  # noqa: PLC0415 — lazy: the core never imports pygame
-            DrawOptions, Renderer, default_window_size, init_pygame)
-        from game.scene import SceneBuilder  # noqa: PLC0415
-
         if self._renderer is None:
-            init_pygame()
+            # lazy: only rendering imports pygame (game.front); the core never does
+            from game.front.frames import FrameRenderer  # noqa: PLC0415
+            from game.scene import SceneBuilder  # noqa: PLC0415
+
             builder = SceneBuilder(self.level, self.graph, view_range=self.view_range,
                                    fov_deg=float(self.config["world.fov_deg"]))
-            size = tuple(self.render_size or default_window_size(builder.static))
-            if self.render_mode == "human":
-                pygame.display.set_caption(f"Stealthfield — {self.level.name}")
-                target = pygame.display.set_mode(size)
-            else:
-                if pygame.display.get_surface() is None:
-                    pygame.display.set_mode((1, 1), pygame.HIDDEN)  # pixel formats for convert()
-                target = pygame.Surface(size)
-            self._renderer = (builder, Renderer(builder.static, size), target)
-        builder, renderer, target = self._renderer
-        scene = builder.from_world(self.world)
-        renderer.draw(target, scene, DrawOptions(legend=False))
-        if self.render_mode == "human":
-            pygame.event.pump()
-            pygame.display.flip()
-            return None
-        return np.ascontiguousarray(pygame.surfarray.array3d(target).swapaxes(0, 1))
+            self._renderer = FrameRenderer(builder, self.render_mode, self.render_size,
+                                           title=f"Stealthfield — {self.level.name}")
+        return self._renderer.draw(self.world)
 
     def close(self) -> None:
         if self._renderer is not None:
-            import pygame  # noqa: PLC0415
-
-            if self.render_mode == "human":
-                pygame.display.quit()
+            self._renderer.close()
             self._renderer = None
 
 

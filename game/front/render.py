@@ -129,9 +129,8 @@ class Layout:
 class Renderer:
     """Draws scenes of one :class:`StaticScene` onto a Surface of a given size.
 
-    >>> # doctest: +SKIP
-    >>> renderer = Renderer(builder.static, (900, 700))
-    >>> renderer.draw(screen, builder.from_world(world, "K"), DrawOptions(show_plans=True))
+    >>> renderer = Renderer(builder.static, (900, 700))  # doctest: +SKIP
+    >>> renderer.draw(screen, builder.from_world(world, "K"), DrawOptions(show_plans=True))  # doctest: +SKIP
     """
 
     HUD_HEIGHT = 50
