@@ -84,8 +84,10 @@ class PlayGame(FrameLoop):
     ``lockstep=True`` advances exactly one physics step per :meth:`frame`; otherwise the
     world follows the wall clock.
 
-    >>> game = PlayGame(PlaySettings("miami", autopilot="maxmin", overlay="K"), lockstep=True)  # doctest: +SKIP
-    >>> times = game.run(frames=120)  # doctest: +SKIP
+    Usage (opens a window)::
+
+        game = PlayGame(PlaySettings("miami", autopilot="maxmin", overlay="K"), lockstep=True)
+        times = game.run(frames=120)
     """
 
     def __init__(
