@@ -3,7 +3,7 @@
 * ``navmesh`` imports nothing of ``ai``, ``game``, ``headless``;
 * ``ai`` imports only ``navmesh`` (of ours);
 * ``game`` outside ``game/front`` never imports pygame, ``headless`` or ``game.front`` at
-  module level; inside a function only ``game/env.py`` may import ``game.front`` lazily
+  module level; inside a function only ``game/match.py`` (rendering the environments) may import ``game.front`` lazily
   (rendering on request), and nothing of ``game`` core imports pygame or headless anywhere;
 * ``game/front`` imports nothing of ``headless``.
 """
@@ -80,7 +80,7 @@ def test_game_core_never_imports_pygame_headless_or_the_front_end() -> None:
             if _root(module) in ("pygame", "headless"):
                 bad.append(f"{rel} imports {module}")
             elif module == "game.front" or module.startswith("game.front."):
-                if top or rel != Path("game/env.py"):
+                if top or rel != Path("game/match.py"):
                     bad.append(f"{rel} imports {module}" + (" at module level" if top else ""))
     assert bad == []
 
