@@ -127,6 +127,13 @@ class ScriptedGuards(GuardAI):
     def extra_information(self, values: np.ndarray) -> None:
         self._extra = information_layer(values, self.graph.n)
 
+    def hears_stimuli(self) -> bool:
+        """Scripted guards investigate strong stimulus layers (no weight floor: no weights)."""
+        return True
+
+    def set_extra_information(self, layer: np.ndarray) -> None:
+        self.extra_information = layer
+
     # ------------------------------------------------------------------ timers and states
     def tick(self, view: WorldView, dt: float) -> None:
         """Advance every guard's timers and switch states (see the class docstring)."""

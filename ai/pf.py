@@ -122,6 +122,16 @@ class PotentialFieldGuards(GuardAI):
     def information_weight_floor(self, value: float | None) -> None:
         self.field.information_weight_floor = value
 
+    def hears_stimuli(self) -> bool:
+        """PF guards read the stimuli's layer and weight floor."""
+        return True
+
+    def set_extra_information(self, layer: np.ndarray) -> None:
+        self.extra_information = layer
+
+    def set_information_weight_floor(self, floor: float) -> None:
+        self.information_weight_floor = floor
+
     def set_confidence_decay(self, nodes: np.ndarray, rate: float) -> None:
         """Zones hook: confidence decay ``rate`` per second in ``nodes`` (indices or a mask)."""
         self.field.set_confidence_decay(nodes, rate)

@@ -3,14 +3,15 @@
 The paper's seven mechanics (§"Extensible Stealth-Mechanism Simulation") and any mechanic a
 user writes are **stimuli**: small objects that know how they inject into the information
 field, how they decay and when they end. The guard AI never learns which mechanic it is
-looking at; it reads two generic hooks that a :class:`StimulusSet` drives once per AI tick:
+looking at; it reads two generic hooks of :class:`~ai.view.GuardAI` (no-ops by default;
+a mode opts in with ``hears_stimuli()``) that a :class:`StimulusSet` drives once per AI tick:
 
-* ``guard_ai.extra_information`` — the sum of every active stimulus's layer (n,), added to
+* ``guard_ai.set_extra_information(layer)`` — the sum of every active stimulus's layer (n,), added to
   I inside the potential (PF, eq. 5) or read as information (FSM, Staleness). Layers are
   ``≤ 0`` where they attract guards: the paper's positive amplitudes enter as ``−A·α^d``.
-* ``guard_ai.information_weight_floor`` — the largest ``information_weight_floor`` any
-  active stimulus asks for (PF: ``w_I`` never falls below it; modes without weights have
-  no such hook and ignore it). This is how an alarm puts guards on alert.
+* ``guard_ai.set_information_weight_floor(floor)`` — the largest ``information_weight_floor``
+  any active stimulus asks for (PF: ``w_I`` never falls below it; modes without weights
+  keep the default no-op). This is how an alarm puts guards on alert.
 
 A **zone** (:class:`Zone`) is the static counterpart: it says what it does to the
 confidence decay of its cells and to the guards' view range when the player stands in it.
@@ -43,15 +44,12 @@ import numpy as np
 
 from navmesh.graph import UNREACHABLE_HOPS, NodeGraph
 
-from .params import _NON_NEGATIVE, _UNIT, _Params
-from .view import Event, WorldView
+from .errors import StimulusError
+from .params import _NON_NEGATIVE, _POSITIVE, _UNIT, _Params
+from .view import Event, GuardAI, WorldView
 
 #: importlib.metadata entry-point group under which installed packages register stimuli
 ENTRY_POINT_GROUP = "stealthfield.stimuli"
-
-
-class StimulusError(ValueError):
-    """A stimulus plugin that cannot be loaded; the message is one line naming it."""
 
 
 # ---------------------------------------------------------------------------- parameters
@@ -277,8 +275,8 @@ class Noise(Stimulus):
     def start(self, ctx: FieldContext) -> None:
         self.shape = ctx.falloff(self.node, self.falloff, self.max_hops)
 
-    def inject(self, ctx: FieldContext) -> np.ndarray:
-        return -self.level * self.shape
+    def inject(self, ctx: FieldContext) -> np.ndarray | None:
+        return None if self.shape is None else -self.level * self.shape
 
     def decay(self, dt: float) -> None:
         self.level *= self.rate**dt
@@ -313,7 +311,7 @@ class StaticDecoy(Stimulus):
     def start(self, ctx: FieldContext) -> None:
         self.layer = -self.amplitude * ctx.falloff(self.node, self.falloff)
 
-    def inject(self, ctx: FieldContext) -> np.ndarray:
+    def inject(self, ctx: FieldContext) -> np.ndarray | None:
         return self.layer
 
     def on_tick(self, view: WorldView, dt: float) -> None:
@@ -359,8 +357,8 @@ class Corpse(Stimulus):
     def start(self, ctx: FieldContext) -> None:
         self.shape = ctx.falloff(self.node, self.falloff)
 
-    def inject(self, ctx: FieldContext) -> np.ndarray:
-        return -self.level * self.shape
+    def inject(self, ctx: FieldContext) -> np.ndarray | None:
+        return None if self.shape is None else -self.level * self.shape
 
     def decay(self, dt: float) -> None:
         self.level *= self.rate**dt
@@ -468,8 +466,9 @@ class StimulusSet:
     decays by ``dt``; the tick's events go to every active stimulus's ``on_event`` and then
     to the registry's rule for their kind, which may create new stimuli; every stimulus sees
     the world (``on_tick``); finished ones are removed; the sum of the layers is assigned to
-    ``guard_ai.extra_information`` and the largest weight floor to
-    ``guard_ai.information_weight_floor`` — for every guard AI that has those attributes.
+    ``guard_ai.set_extra_information`` and the largest weight floor to
+    ``guard_ai.set_information_weight_floor`` — for every guard AI whose
+    :meth:`~ai.view.GuardAI.hears_stimuli` says so.
     """
 
     def __init__(
@@ -477,7 +476,7 @@ class StimulusSet:
         graph: NodeGraph,
         params: StimulusParams | None = None,
         *,
-        guard_ai: Any = None,
+        guard_ai: GuardAI | None = None,
         rng: np.random.Generator | None = None,
         zones: Mapping[str, np.ndarray] | None = None,
         rules: Mapping[str, Rule] | None = None,
@@ -572,15 +571,16 @@ class StimulusSet:
         guards = self.guard_ai
         if guards is None:
             return
-        if hasattr(guards, "extra_information") and (self._active or not self._pushed_zero):
+        if not guards.hears_stimuli():
+            return
+        if self._active or not self._pushed_zero:
             layer = self.layer()
-            guards.extra_information = layer
+            guards.set_extra_information(layer)
             self._pushed_zero = not layer.any()
-        if hasattr(guards, "information_weight_floor"):
-            floor = self.weight_floor()
-            if floor != self._pushed_floor:
-                guards.information_weight_floor = floor
-                self._pushed_floor = floor
+        floor = self.weight_floor()
+        if floor != self._pushed_floor:
+            guards.set_information_weight_floor(floor)
+            self._pushed_floor = floor
 
     def markers(self) -> list[Stimulus]:
         """Active stimuli the game draws (decoys, corpses, landed throws)."""
@@ -621,7 +621,7 @@ def zones_from_config(section: Mapping[str, Any]) -> dict[str, Zone]:
         for suffix in ("_confidence_decay", "_view_scale"):
             if key.endswith(suffix):
                 kinds.setdefault(key[: -len(suffix)], {})[suffix[1:]] = float(value)
-    return {kind: Zone(kind, **values) for kind, values in kinds.items()}  # type: ignore[arg-type]
+    return {kind: Zone(kind, **values) for kind, values in kinds.items()}
 
 
 def zone_view_scale(zones: Mapping[str, Zone], masks: Mapping[str, np.ndarray], n: int) -> np.ndarray:
@@ -634,18 +634,18 @@ def zone_view_scale(zones: Mapping[str, Zone], masks: Mapping[str, np.ndarray], 
     return scale
 
 
-def apply_zones(guard_ai: Any, zones: Mapping[str, Zone], masks: Mapping[str, np.ndarray]) -> None:
+def apply_zones(guard_ai: GuardAI, zones: Mapping[str, Zone], masks: Mapping[str, np.ndarray]) -> None:
     """Give every zone's cells its confidence decay, on a guard AI with that hook (PF).
 
     Slowest rates first, so where zones overlap the fastest decay wins.
     """
-    setter = getattr(guard_ai, "set_confidence_decay", None)
-    if setter is None:
-        return
-    rules = [(zones[k].confidence_decay, m) for k, m in masks.items()
-             if k in zones and zones[k].confidence_decay is not None and np.any(m)]
-    for rate, mask in sorted(rules, key=lambda item: -item[0]):  # type: ignore[operator]
-        setter(np.asarray(mask, dtype=bool), rate)
+    rules: list[tuple[float, np.ndarray]] = []
+    for kind, mask in masks.items():
+        rate = zones[kind].confidence_decay if kind in zones else None
+        if rate is not None and np.any(mask):
+            rules.append((rate, mask))
+    for rate, mask in sorted(rules, key=lambda item: -item[0]):
+        guard_ai.set_confidence_decay(np.asarray(mask, dtype=bool), rate)
 
 
 # ---------------------------------------------------------------------------- plugins

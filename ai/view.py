@@ -132,6 +132,10 @@ class GuardAI(ABC):
     def decide(self, i: int, view: WorldView) -> int:
         """The next target node of guard ``i``."""
 
+    # ---------------------------------------------------------------- capabilities
+    # What a mode can do beyond deciding, each with a harmless default (MiniGrid's
+    # ``can_overlap``): the world, the stimuli and the front end call these unconditionally.
+
     def explain(self, i: int) -> dict[str, Any] | None:
         """Why guard ``i`` took its last decision, for modes that can say (else None)."""
         return None
@@ -139,6 +143,31 @@ class GuardAI(ABC):
     def state_name(self, i: int) -> str:
         """A short label of guard ``i``'s behaviour state, for traces and the game HUD."""
         return self.mode
+
+    def fields(self) -> dict[str, np.ndarray]:
+        """The mode's per-node fields by name (``"I"``, ``"C"``, ``"K"``, ...) for overlays.
+
+        Empty by default: a mode without fields draws no overlay.
+        """
+        return {}
+
+    def hears_stimuli(self) -> bool:
+        """Whether the stimuli's information layer reaches this mode (default: no).
+
+        When false the stimulus set does not even compute the layer for it; a mode that
+        returns true receives :meth:`set_extra_information` and
+        :meth:`set_information_weight_floor` after every AI tick.
+        """
+        return False
+
+    def set_extra_information(self, layer: np.ndarray) -> None:
+        """Receive the sum of the active stimuli's layers, shape ``(n,)`` (default: ignored)."""
+
+    def set_information_weight_floor(self, floor: float) -> None:
+        """Receive the largest information-weight floor the stimuli ask for (default: ignored)."""
+
+    def set_confidence_decay(self, nodes: np.ndarray, rate: float) -> None:
+        """Let confidence decay at ``rate`` per second on ``nodes`` (a zone; default: ignored)."""
 
 
 @dataclass(frozen=True)

@@ -246,7 +246,7 @@ class PlayerActions:
 
     def perform(self, action: Action) -> bool | str:
         """Carry out a scripted player's :class:`~ai.view.Action` (:data:`ACTIONS`)."""
-        return perform(self._world(), action)  # type: ignore[no-any-return]
+        return perform(self._world(), action)
 
     def landing_node(self, x: float, y: float) -> int:
         """Where a decoy thrown at (x, y) lands (:func:`landing_node`)."""

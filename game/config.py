@@ -16,11 +16,9 @@ from collections.abc import Iterable, Mapping
 from pathlib import Path
 from typing import Any
 
+from game.errors import ConfigError
+
 DEFAULTS_PATH = Path(__file__).with_name("defaults.toml")
-
-
-class ConfigError(ValueError):
-    """A bad override or config file; the message is one line naming the key."""
 
 
 def _flatten(table: Mapping[str, Any], prefix: str = "") -> dict[str, Any]:

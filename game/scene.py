@@ -27,7 +27,7 @@ with matplotlib could be another.
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
@@ -44,45 +44,91 @@ if TYPE_CHECKING:
 
 Point = tuple[float, float]
 
-#: Overlay keys in the order the overlay key cycles through them.
-OVERLAYS: tuple[str, ...] = ("none", "I", "C", "N", "P", "K")
-
-#: Human-readable names of the overlays (legend titles).
-OVERLAY_LABELS: dict[str, str] = {
-    "none": "no overlay",
-    "I": "Information I",
-    "C": "Confidence C",
-    "N": "Connectivity N",
-    "P": "Composite potential P",
-    "K": "Kernel K",
-}
-
-#: Accepted spellings of overlay names on the command line.
-OVERLAY_ALIASES: dict[str, str] = {
-    "none": "none", "off": "none",
-    "i": "I", "information": "I", "info": "I",
-    "c": "C", "confidence": "C",
-    "n": "N", "connectivity": "N",
-    "p": "P", "potential": "P", "composite": "P",
-    "k": "K", "kernel": "K",
-}
-
 #: Rays per radian of field of view (about one every 1.6°), before the corner rays.
 RAYS_PER_RADIAN = 36.0
 #: Angular offset of the two rays cast either side of a wall corner.
 _CORNER_EPS = 1e-4
 
 
+# ---------------------------------------------------------------------------- overlays
+
+
+@dataclass(frozen=True)
+class Overlay:
+    """A field overlay: which of the guard AI's ``fields()`` it draws, and how.
+
+    ``fields`` names the arrays it reads (the first is required: without it the overlay
+    says "not available"); ``combine`` turns them into the drawn values and the legend
+    title (default: the first array and ``label``); ``aliases`` are extra spellings for
+    ``--overlay``. Register one with :func:`register_overlay`.
+    """
+
+    key: str
+    label: str
+    fields: tuple[str, ...]
+    combine: Callable[..., tuple[np.ndarray, str]] | None = None
+    aliases: tuple[str, ...] = ()
+
+    def layer_values(self, sources: Sequence[Any]) -> tuple[np.ndarray, str]:
+        """The values to draw and the legend title, from the arrays named by ``fields``."""
+        if self.combine is not None:
+            return self.combine(*sources)
+        return np.asarray(sources[0], dtype=np.float64), self.label
+
+
+def _information_plus_stimuli(info: Any, extra: Any) -> tuple[np.ndarray, str]:
+    """``I`` shows the information field plus the stimuli layer (what enters P)."""
+    values = np.asarray(info, dtype=np.float64)
+    if extra is not None and np.any(np.asarray(extra) != 0):
+        return values + np.asarray(extra, dtype=np.float64), "Information I + stimuli"
+    return values, "Information I"
+
+
+#: The overlay registry, in the order the overlay key cycles through it ("none" first).
+OVERLAYS: dict[str, Overlay | None] = {"none": None}
+#: Accepted spellings of overlay names on the command line.
+OVERLAY_ALIASES: dict[str, str] = {"none": "none", "off": "none"}
+
+
+def register_overlay(overlay: Overlay) -> None:
+    """Add ``overlay`` to the cycle and to ``--overlay`` (its key and aliases)."""
+    OVERLAYS[overlay.key] = overlay
+    for name in (overlay.key, *overlay.aliases):
+        OVERLAY_ALIASES[name.lower()] = overlay.key
+
+
+def unregister_overlay(key: str) -> None:
+    """Remove an overlay added by :func:`register_overlay` (tests, notebooks)."""
+    OVERLAYS.pop(key, None)
+    for name, target in list(OVERLAY_ALIASES.items()):
+        if target == key:
+            del OVERLAY_ALIASES[name]
+
+
+def overlay_label(key: str) -> str:
+    """The legend title of overlay ``key``."""
+    overlay = OVERLAYS.get(key)
+    return "no overlay" if overlay is None else overlay.label
+
+
+register_overlay(Overlay("I", "Information I", ("I", "I_extra"), _information_plus_stimuli,
+                         ("information", "info")))
+register_overlay(Overlay("C", "Confidence C", ("C",), aliases=("confidence",)))
+register_overlay(Overlay("N", "Connectivity N", ("N",), aliases=("connectivity",)))
+register_overlay(Overlay("P", "Composite potential P", ("P",), aliases=("potential", "composite")))
+register_overlay(Overlay("K", "Kernel K", ("K",), aliases=("kernel",)))
+
 def overlay_key(name: str) -> str:
-    """The overlay key (``none``, ``I``, ``C``, ``N``, ``P``, ``K``) for a name or alias.
+    """The overlay key (``none``, ``I``, ``C``, ``N``, ``P``, ``K``, ...) for a name or alias.
 
     >>> overlay_key("kernel"), overlay_key("I")
     ('K', 'I')
     """
     key = OVERLAY_ALIASES.get(name.strip().lower())
     if key is None:
-        names = "none, information, confidence, connectivity, potential, kernel"
-        raise ValueError(f"unknown overlay {name!r} (choose from {names}, or I C N P K)")
+        names = ", ".join(sorted(set(OVERLAY_ALIASES) - set(OVERLAYS), key=str.lower))
+        raise ValueError(f"unknown overlay {name!r} (choose from {', '.join(OVERLAYS)}, "
+                         f"or {names})")
     return key
 
 
@@ -213,7 +259,7 @@ class FieldLayer:
         vmax = float(values.max()) if len(values) else 0.0
         scale = max(abs(vmin), abs(vmax))
         norm = values / scale if scale > 1e-12 else np.zeros_like(values)
-        return cls(key, label or OVERLAY_LABELS.get(key, key), values, vmin, vmax, norm)
+        return cls(key, label or overlay_label(key), values, vmin, vmax, norm)
 
 
 @dataclass(frozen=True, eq=False)
@@ -292,26 +338,18 @@ class SceneBuilder:
 
     # ------------------------------------------------------------------ fields
     def field_layer(self, key: str, fields: Mapping[str, np.ndarray]) -> FieldLayer | None:
-        """The layer of overlay ``key`` from a guard AI's ``fields()`` dict (None if absent).
-
-        ``I`` shows the information field plus the stimuli layer (``I + I_extra``), which
-        is what enters P.
-        """
-        if key == "none":
+        """The layer of overlay ``key`` from a guard AI's ``fields()`` dict (None if absent)."""
+        overlay = OVERLAYS.get(key)
+        if overlay is None:
             return None
-        extra = fields.get("I_extra") if key == "I" else None
-        sources: tuple[Any, Any] = (fields.get(key), extra)
+        sources = tuple(fields.get(name) for name in overlay.fields)
         if sources[0] is None:
             return None
         ids = tuple(id(s) for s in sources)
         cached = self._layers.get(key)
         if cached is not None and cached[0] == ids:
             return cached[2]
-        values = np.asarray(sources[0], dtype=np.float64)
-        label = OVERLAY_LABELS[key]
-        if key == "I" and sources[1] is not None and np.any(np.asarray(sources[1]) != 0):
-            values = values + np.asarray(sources[1], dtype=np.float64)
-            label = "Information I + stimuli"
+        values, label = overlay.layer_values(sources)
         layer = FieldLayer.from_values(key, values, label)
         self._layers[key] = (ids, sources, layer)  # keep the sources alive: ids stay unique
         return layer
@@ -320,10 +358,10 @@ class SceneBuilder:
     def from_world(self, world: World, overlay: str = "none", plans: bool = False) -> Scene:
         """The frame of ``world`` now, with the ``overlay`` field and optionally the plans."""
         concealed = _concealed(world.zones, world.player.node)
-        reach = world.view_range * _view_scale(world, concealed)
+        reach = world.view_range * float(world.view_scale_at[world.player.node])
         seen = set(world.seen_by)
         positions = self.graph.positions
-        explain = getattr(world.guard_ai, "explain", None)
+        guard_ai = world.guard_ai
         guards = []
         for i, g in enumerate(world.guards):
             cone = self.cone(g.pos, g.heading, reach) if g.active else np.zeros((0, 2))
@@ -331,7 +369,7 @@ class SceneBuilder:
             if plans and g.active:
                 extra["target"] = (float(positions[g.target][0]), float(positions[g.target][1]))
                 extra["path"] = np.asarray(list(g.waypoints), dtype=np.float64).reshape(-1, 2)
-                record = explain(i) if explain is not None else None
+                record = guard_ai.explain(i)
                 if record and record.get("candidates"):
                     nodes = [c["node"] for c in record["candidates"]]
                     extra["candidates"] = positions[nodes]
@@ -339,15 +377,15 @@ class SceneBuilder:
                     extra["chosen"] = (float(won[0]), float(won[1]))
             guards.append(GuardDrawing(
                 pos=g.pos, heading=g.heading, active=g.active, sees_player=i in seen,
-                state=_state_name(world, i) if g.active else "down", cone=cone, **extra,
+                state=str(guard_ai.state_name(i)) if g.active else "down", cone=cone, **extra,
             ))
         field_layer, note = None, ""
         if overlay != "none":
-            getter = getattr(world.guard_ai, "fields", None)
-            if getter is None:
-                note = f"no fields in mode {getattr(world.guard_ai, 'mode', '?')}"
+            fields = guard_ai.fields()
+            if not fields:
+                note = f"no fields in mode {guard_ai.mode}"
             else:
-                field_layer = self.field_layer(overlay, getter())
+                field_layer = self.field_layer(overlay, fields)
                 if field_layer is None:
                     note = f"field {overlay} not available"
         if world.done:
@@ -364,9 +402,9 @@ class SceneBuilder:
                 hp_max=world.hp_max, sprinting=bool(world.sprinting), concealed=concealed,
             ),
             seen_by=tuple(world.seen_by),
-            attackers=int(getattr(world, "attackers", 0)),
+            attackers=int(world.attackers),
             status=status,
-            mode=str(getattr(world.guard_ai, "mode", "")),
+            mode=guard_ai.mode,
             abstraction=world.graph.kind,
             overlay=overlay,
             layer=field_layer,
@@ -374,8 +412,8 @@ class SceneBuilder:
             reach=reach,
             attack_range=world.attack_range,
             agent_radius=world.radius,
-            markers=_markers(world),
-            rain=_rain(world),
+            markers=np.asarray(world.stimulus_points(), dtype=np.float64).reshape(-1, 2),
+            rain=world.raining,
             events=tuple(e.kind for e in world.tick_events),
             captures=world.m.captures,
         )
@@ -384,41 +422,6 @@ class SceneBuilder:
 def _concealed(zones: Mapping[str, np.ndarray], node: int) -> bool:
     mask = zones.get("concealment")
     return bool(mask is not None and 0 <= node < len(mask) and mask[node])
-
-
-def _view_scale(world: World, concealed: bool) -> float:
-    """The factor on the guards' view range where the player stands (as World.sees uses)."""
-    per_node = getattr(world, "view_scale_at", None)
-    if per_node is not None:
-        return float(per_node[world.player.node])
-    return float(world.concealment_view_scale) if concealed else 1.0
-
-
-def _state_name(world: World, i: int) -> str:
-    try:
-        return str(world.guard_ai.state_name(i))
-    except (AttributeError, IndexError, TypeError):
-        return ""
-
-
-def _rain(world: World) -> bool | None:
-    """Whether it rains, for worlds that know about weather (None otherwise)."""
-    for name in ("raining", "rain"):
-        value = getattr(world, name, None)
-        if isinstance(value, (bool, np.bool_)):
-            return bool(value)
-    return None
-
-
-def _markers(world: World) -> np.ndarray:
-    """Positions of dynamic stimuli the world exposes (``stimulus_points()``), if any."""
-    getter = getattr(world, "stimulus_points", None)
-    if getter is None:
-        return np.zeros((0, 2))
-    try:
-        return np.asarray(getter(), dtype=np.float64).reshape(-1, 2)
-    except (TypeError, ValueError):
-        return np.zeros((0, 2))
 
 
 # ---------------------------------------------------------------------------- ray casting
@@ -476,6 +479,7 @@ def vision_cone(
 
 
 __all__ = [
-    "OVERLAYS", "OVERLAY_LABELS", "FieldLayer", "GuardDrawing", "PlayerDrawing", "Scene",
-    "SceneBuilder", "StaticScene", "overlay_key", "vision_cone",
+    "OVERLAYS", "OVERLAY_ALIASES", "FieldLayer", "GuardDrawing", "Overlay", "PlayerDrawing",
+    "Scene", "SceneBuilder", "StaticScene", "overlay_key", "overlay_label", "register_overlay",
+    "unregister_overlay", "vision_cone",
 ]

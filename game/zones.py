@@ -12,7 +12,7 @@ from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
-import shapely  # type: ignore[import-untyped]
+import shapely
 
 from ai.stimuli import Zone, zone_view_scale, zones_from_config
 from navmesh.graph import NodeGraph

@@ -1,8 +1,11 @@
 """The ``stealth`` command line (SPEC §9).
 
-A user's mistake — a broken level, an unknown mode, a point inside a wall, a bad override —
-ends with one line ``stealth: error: ...`` on stderr and exit code 2, never a traceback.
-With ``--json`` stdout carries exactly one JSON document; logs go to stderr.
+A user's mistake — a broken level, an unknown mode, a point inside a wall, a bad override,
+a bad option — ends with one line ``stealth: error: ...`` on stderr and exit code 2, never a
+traceback: every layer raises a subclass of :class:`~navmesh.errors.StealthError` and
+:func:`main` prints it. With ``--json`` stdout carries exactly one JSON document; logs go to
+stderr. The heavy commands live in their own modules and are imported only when they run
+(one small ``_cmd_*`` function each), so ``stealth --help`` needs no pygame.
 """
 
 from __future__ import annotations
@@ -10,25 +13,16 @@ from __future__ import annotations
 import argparse
 import json
 import sys
-from collections.abc import Callable, Sequence
-from typing import Any
+from collections.abc import Sequence
+from typing import Any, NoReturn
 
 from ai import GUARD_MODES, PLAYER_POLICIES
+from navmesh.errors import StealthError
+from navmesh.graph import ABSTRACTIONS
+
+from .errors import UserError
 
 EXIT_USER_ERROR = 2
-
-
-class UserError(Exception):
-    """A problem with what the user asked for; printed as one line, exit code 2."""
-
-
-def _user_errors() -> tuple[type[BaseException], ...]:
-    from ai.stimuli import StimulusError
-    from game.config import ConfigError
-    from navmesh.level import LevelError
-    from navmesh.mesh import OutsideError
-
-    return (UserError, LevelError, ConfigError, OutsideError, StimulusError)
 
 
 def _point(text: str) -> tuple[float, float]:
@@ -47,11 +41,19 @@ def _emit_json(document: Any) -> None:
 
 
 # ---------------------------------------------------------------------- levels / validate
-def level_stats(level: Any) -> dict[str, Any]:
-    """Paper Table 1 for one level: navmesh triangles and areas, grid size and counts."""
+def _navmesh(level: Any) -> Any:
+    """The level's navmesh (the partition graph's, cached per process)."""
     from navmesh.graph import graph_for
 
     mesh = graph_for(level, "partition").mesh
+    if mesh is None:  # pragma: no cover - a partition graph always has its mesh
+        raise RuntimeError(f"level {level.name}: the partition graph has no navmesh")
+    return mesh
+
+
+def level_stats(level: Any) -> dict[str, Any]:
+    """Paper Table 1 for one level: navmesh triangles and areas, grid size and counts."""
+    mesh = _navmesh(level)
     walkable = int(level.occupancy.sum())
     return {
         "name": level.name,
@@ -94,8 +96,9 @@ def cmd_levels(args: argparse.Namespace) -> int:
 
 
 def cmd_validate(args: argparse.Namespace) -> int:
+    from navmesh.errors import LevelError
     from navmesh.graph import check_fits
-    from navmesh.level import LevelError, load_level
+    from navmesh.level import load_level
 
     failed = 0
     for name in args.level:
@@ -113,19 +116,15 @@ def cmd_validate(args: argparse.Namespace) -> int:
 
 # ---------------------------------------------------------------------- path
 def cmd_path(args: argparse.Namespace) -> int:
-    from navmesh.graph import graph_for
     from navmesh.level import load_level
 
-    level = load_level(args.level)
-    mesh = graph_for(level, "partition").mesh
-    path = mesh.find_path(args.from_, args.to)
-    document = {"points": [[float(x), float(y)] for x, y in path.points],
-                "length": float(path.length)}
+    path = _navmesh(load_level(args.level)).find_path(args.from_, args.to)
+    points = [[float(x), float(y)] for x, y in path.points]
     if args.json:
-        _emit_json(document)
+        _emit_json({"points": points, "length": float(path.length)})
     else:
-        print(f"length {document['length']:.4f} through {len(path.points)} points")
-        for x, y in document["points"]:
+        print(f"length {float(path.length):.4f} through {len(points)} points")
+        for x, y in points:
             print(f"  {x:.4f},{y:.4f}")
     return 0
 
@@ -179,117 +178,229 @@ def cmd_sim(args: argparse.Namespace) -> int:
     return 0
 
 
+# ---------------------------------------------------------------------- presets
+def cmd_presets(args: argparse.Namespace) -> int:
+    """``stealth presets``: the bundled presets and their descriptions."""
+    from .presets import bundled_presets
+
+    listed = bundled_presets()
+    if args.json:
+        _emit_json([{"name": name, "description": text} for name, text in listed])
+        return 0
+    width = max((len(name) for name, _ in listed), default=0)
+    for name, text in listed:
+        print(f"{name:<{width}}  {text}")
+    return 0
+
+
+# ---------------------------------------------------------------------- lazy commands
+def _cmd_run(args: argparse.Namespace) -> int:
+    from .sweep import cmd_run
+
+    return cmd_run(args)
+
+
+def _cmd_report(args: argparse.Namespace) -> int:
+    from .report import cmd_report
+
+    return cmd_report(args)
+
+
+def _cmd_mechanics(args: argparse.Namespace) -> int:
+    from .mechanics import cmd_mechanics
+
+    return cmd_mechanics(args)
+
+
+def _cmd_play(args: argparse.Namespace) -> int:
+    from game.front.play import cmd_play
+
+    return cmd_play(args)
+
+
+def _cmd_replay(args: argparse.Namespace) -> int:
+    from game.front.replay import cmd_replay
+
+    return cmd_replay(args)
+
+
 # ---------------------------------------------------------------------- parser
-def _optional_command(module: str, name: str) -> Callable[[argparse.Namespace], int]:
-    """A command implemented in another module, imported only when it runs."""
+class UsageError(UserError):
+    """A command line argparse rejects (unknown option, bad choice, missing argument)."""
 
-    def run(args: argparse.Namespace) -> int:
-        from importlib import import_module
 
-        return int(getattr(import_module(module), name)(args))
+class _Parser(argparse.ArgumentParser):
+    """An argparse parser whose errors are one ``stealth: error: ...`` line (exit 2)."""
 
-    return run
+    def error(self, message: str) -> NoReturn:
+        raise UsageError(message)
+
+
+class _Help(argparse.ArgumentDefaultsHelpFormatter, argparse.RawDescriptionHelpFormatter):
+    """Help that shows every option's default and keeps the epilog's line breaks.
+
+    A default that is "nothing" (None, False, an empty list) is not printed: flags are off
+    by default, and an option whose absence means something says so in its own help.
+    """
+
+    def _get_help_string(self, action: argparse.Action) -> str | None:
+        if action.default is None or action.default is False or action.default == []:
+            return action.help
+        return super()._get_help_string(action)
+
+
+def _version() -> str:
+    from importlib.metadata import PackageNotFoundError, version
+
+    try:
+        return version("stealthfield")
+    except PackageNotFoundError:  # running from a source tree that is not installed
+        return "unknown (not installed)"
 
 
 def build_parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(
-        prog="stealth", description="Stealthfield: guards driven by composite potential fields."
+    """The ``stealth`` parser; its choices come from the registries and name constants."""
+    from game.front.keys import key_table
+    from game.scene import OVERLAYS
+    from game.world import SCENARIOS
+
+    modes, policies = list(GUARD_MODES), list(PLAYER_POLICIES)
+    abstractions, scenarios = list(ABSTRACTIONS), list(SCENARIOS)
+    parser = _Parser(
+        prog="stealth", description="Stealthfield: guards driven by composite potential fields.",
+        formatter_class=_Help,
     )
+    parser.add_argument("--version", action="version", version=f"stealth {_version()}")
     sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
 
-    p = sub.add_parser("levels", help="paper Table 1 figures of levels")
-    p.add_argument("level", nargs="*", help="level files or bundled names (default: all bundled)")
-    p.add_argument("--json", action="store_true", help="one JSON document on stdout")
+    def command(name: str, text: str, **kwargs: Any) -> argparse.ArgumentParser:
+        return sub.add_parser(name, help=text, description=text, formatter_class=_Help,
+                              **kwargs)
+
+    def add_json(p: argparse.ArgumentParser) -> None:
+        p.add_argument("--json", action="store_true",
+                       help="print one JSON document on stdout (logs go to stderr)")
+
+    def add_set(p: argparse.ArgumentParser) -> None:
+        p.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
+                       help="override a config value (game/defaults.toml key), e.g. "
+                            "--set world.view_range=6; repeatable (default: none)")
+
+    p = command("levels", "paper Table 1 figures of levels")
+    p.add_argument("level", nargs="*", default=[],
+                   help="level files or bundled names (default: every bundled level)")
+    add_json(p)
     p.set_defaults(func=cmd_levels)
 
-    p = sub.add_parser("validate", help="check level files")
-    p.add_argument("level", nargs="+")
+    p = command("validate", "check level files: exit 0, or one error line per bad file and exit 2")
+    p.add_argument("level", nargs="+", help="level files or bundled names")
     p.set_defaults(func=cmd_validate)
 
-    p = sub.add_parser("path", help="navmesh (funnel) path between two points")
-    p.add_argument("level")
-    p.add_argument("--from", dest="from_", type=_point, required=True, metavar="X,Y")
-    p.add_argument("--to", type=_point, required=True, metavar="X,Y")
-    p.add_argument("--json", action="store_true")
+    p = command("path", "navmesh (funnel) path between two points")
+    p.add_argument("level", help="level file or bundled name")
+    p.add_argument("--from", dest="from_", type=_point, required=True, metavar="X,Y",
+                   help="start point in world units (required)")
+    p.add_argument("--to", type=_point, required=True, metavar="X,Y",
+                   help="goal point in world units (required)")
+    add_json(p)
     p.set_defaults(func=cmd_path)
 
-    p = sub.add_parser("sim", help="run one trial and print its metrics")
-    p.add_argument("level")
-    p.add_argument("--guards", choices=sorted(GUARD_MODES), default="pf")
-    p.add_argument("--player", choices=sorted(PLAYER_POLICIES), default="maxmin")
-    p.add_argument("--abstraction", choices=["grid", "partition"], default="grid")
-    p.add_argument("--scenario", choices=["capture", "fixed"], default="capture")
-    p.add_argument("--seed", type=int, default=0)
-    p.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
-                   help="override a config value, e.g. --set world.view_range=6")
-    p.add_argument("--json", action="store_true")
-    p.add_argument("--trace", metavar="FILE", help="write every AI tick as a JSON line")
+    p = command("sim", "run one trial and print its metrics")
+    p.add_argument("level", help="level file or bundled name")
+    p.add_argument("--guards", choices=modes, default="pf", help="guard mode")
+    p.add_argument("--player", choices=policies, default="maxmin", help="player policy")
+    p.add_argument("--abstraction", choices=abstractions, default="grid",
+                   help="node graph the AI runs on")
+    p.add_argument("--scenario", choices=scenarios, default="capture",
+                   help="capture: ends at HP 0; fixed: respawn, always the full duration")
+    p.add_argument("--seed", type=int, default=0, help="trial seed")
+    add_set(p)
+    add_json(p)
+    p.add_argument("--trace", metavar="FILE", default=None,
+                   help="write every AI tick as a JSON line to FILE (default: no trace)")
     p.add_argument("--explain", action="store_true",
                    help="add the first guard's decision explained to each trace line "
                         "(to stderr when no --trace)")
     p.add_argument("--stimulus", action="append", default=[], metavar="FILE.py:NAME",
                    help="add a stimulus (a Stimulus subclass or factory in FILE.py, or an "
-                        "installed stealthfield.stimuli entry point); repeatable")
+                        "installed stealthfield.stimuli entry point); repeatable (default: none)")
     p.set_defaults(func=cmd_sim)
 
-    p = sub.add_parser("mechanics", help="measured effects of the stealth mechanics (docs/mechanics.md)")
-    p.add_argument("--seeds", type=int, default=30, help="paired seeds per mechanic (default 30)")
+    p = command("mechanics", "measured effects of the stealth mechanics (docs/mechanics.md)")
+    p.add_argument("--seeds", type=int, default=30, help="paired seeds per mechanic")
     p.add_argument("--out", default="results/mechanics", help="directory for mechanics.md and .csv")
-    p.add_argument("--workers", type=int, default=None, help="worker processes (1 = in-process)")
-    p.add_argument("--level", default="miami", help="level (default miami)")
-    p.add_argument("--abstraction", choices=["grid", "partition"], default="grid")
-    p.set_defaults(func=_optional_command("headless.mechanics", "cmd_mechanics"))
+    p.add_argument("--workers", type=int, default=None,
+                   help="worker processes, 1 = in-process (default: one per CPU)")
+    p.add_argument("--level", default="miami", help="level file or bundled name")
+    p.add_argument("--abstraction", choices=abstractions, default="grid",
+                   help="node graph the AI runs on")
+    p.set_defaults(func=_cmd_mechanics)
 
-    p = sub.add_parser("run", help="run a sweep (resumable, parallel)")
-    p.add_argument("--preset", default="smoke", help="preset name or TOML file")
+    p = command("presets", "list the bundled presets with their descriptions")
+    add_json(p)
+    p.set_defaults(func=cmd_presets)
+
+    p = command("run", "run a sweep (resumable, parallel)")
+    p.add_argument("--preset", default="smoke",
+                   help="bundled preset name (see `stealth presets`) or a preset TOML file")
     p.add_argument("--out", default=None, help="results directory (default: results/PRESET)")
-    p.add_argument("--workers", type=int, default=None, help="worker processes (1 = in-process)")
-    p.add_argument("--scheduler", default=None, help="Dask scheduler address (cluster extra)")
-    p.set_defaults(func=_optional_command("headless.sweep", "cmd_run"))
+    p.add_argument("--workers", type=int, default=None,
+                   help="worker processes, 1 = in-process (default: one per CPU)")
+    p.add_argument("--scheduler", default=None,
+                   help="address of a Dask scheduler to run the trials on, cluster extra (default: local processes)")
+    p.set_defaults(func=_cmd_run)
 
-    p = sub.add_parser("report", help="tables, CSVs and figures of a results directory")
-    p.add_argument("dir")
-    p.set_defaults(func=_optional_command("headless.report", "cmd_report"))
+    p = command("report", "tables, CSVs and figures of a results directory")
+    p.add_argument("dir", help="results directory written by stealth run")
+    p.set_defaults(func=_cmd_report)
 
-    p = sub.add_parser("play", help="play a level interactively")
-    p.add_argument("level")
-    p.add_argument("--guards", choices=sorted(GUARD_MODES), default="pf")
-    p.add_argument("--abstraction", choices=["grid", "partition"], default="grid")
-    p.add_argument("--autopilot", choices=sorted(PLAYER_POLICIES), default=None)
-    p.add_argument("--frames", type=int, default=None, help="stop after N frames")
-    p.add_argument("--screenshot", default=None, help="save the last frame as PNG")
-    p.add_argument("--overlay", default="none", help="initial field overlay")
-    p.add_argument("--seed", type=int, default=0)
-    p.add_argument("--set", action="append", default=[], metavar="KEY=VALUE")
-    p.add_argument("--scenario", choices=["capture", "fixed"], default="capture",
-                   help="capture: game over at HP 0 (default); fixed: respawn, play 60 s")
+    p = command("play", "play a level interactively",
+                epilog="keys:\n" + key_table())
+    p.add_argument("level", help="level file or bundled name")
+    p.add_argument("--guards", choices=modes, default="pf", help="guard mode")
+    p.add_argument("--abstraction", choices=abstractions, default="grid",
+                   help="node graph the AI runs on")
+    p.add_argument("--autopilot", choices=policies, default=None,
+                   help="let a player policy play; a movement key takes over (default: you play)")
+    p.add_argument("--frames", type=int, default=None,
+                   help="stop after N frames, one physics step each (default: play until Esc)")
+    p.add_argument("--screenshot", default=None, metavar="FILE.png",
+                   help="save the last frame as PNG (default: none)")
+    p.add_argument("--overlay", default="none",
+                   help=f"initial field overlay: {', '.join(OVERLAYS)}")
+    p.add_argument("--seed", type=int, default=0, help="seed of the guards' decisions")
+    add_set(p)
+    p.add_argument("--scenario", choices=scenarios, default="capture",
+                   help="capture: game over at HP 0; fixed: respawn, play the full duration")
     p.add_argument("--mesh", action="store_true", help="start with the grid / navmesh shown")
     p.add_argument("--plans", action="store_true", help="start with the guards' plans shown")
-    p.set_defaults(func=_optional_command("game.front.play", "cmd_play"))
+    p.set_defaults(func=_cmd_play)
 
-    p = sub.add_parser("replay", help="replay a trace written by stealth sim --trace")
-    p.add_argument("trace")
-    p.add_argument("--level", default=None, help="level of the trace (default: from the trace)")
-    p.add_argument("--frames", type=int, default=None)
-    p.add_argument("--screenshot", default=None)
-    p.add_argument("--abstraction", choices=["grid", "partition"], default=None,
+    p = command("replay", "replay a trace written by stealth sim --trace")
+    p.add_argument("trace", help="trace file (JSON lines)")
+    p.add_argument("--level", default=None, help="level of the trace (default: the one the trace names)")
+    p.add_argument("--frames", type=int, default=None,
+                   help="stop after N frames (default: until Esc)")
+    p.add_argument("--screenshot", default=None, metavar="FILE.png",
+                   help="save the last frame as PNG (default: none)")
+    p.add_argument("--abstraction", choices=abstractions, default=None,
                    help="graph the trace's node numbers refer to (default: detected)")
-    p.add_argument("--scenario", choices=["capture", "fixed"], default="capture",
+    p.add_argument("--scenario", choices=scenarios, default="capture",
                    help="scenario of the trace (sets the guards' view range drawn)")
-    p.add_argument("--speed", type=float, default=1.0, help="playback speed (default 1)")
+    p.add_argument("--speed", type=float, default=1.0, help="playback speed factor")
     p.add_argument("--mesh", action="store_true", help="start with the grid / navmesh shown")
     p.add_argument("--plans", action="store_true", help="start with the guards' targets shown")
-    p.set_defaults(func=_optional_command("game.front.replay", "cmd_replay"))
+    p.set_defaults(func=_cmd_replay)
     return parser
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    parser = build_parser()
-    args = parser.parse_args(argv)
+    """Run one ``stealth`` command; returns its exit code (2 for any user error)."""
     try:
+        args = build_parser().parse_args(argv)
         return int(args.func(args))
-    except _user_errors() as error:
-        print(f"stealth: error: {error}", file=sys.stderr)
+    except StealthError as error:
+        print(f"stealth: error: {' '.join(str(error).split())}", file=sys.stderr)
         return EXIT_USER_ERROR
     except KeyboardInterrupt:
         print("stealth: interrupted", file=sys.stderr)
@@ -297,8 +408,4 @@ def main(argv: Sequence[str] | None = None) -> int:
 
 
 if __name__ == "__main__":
-    # Run through the package module so `python -m headless.cli` and the installed script
-    # share one UserError class (other modules import it from headless.cli).
-    from headless.cli import main as _main
-
-    sys.exit(_main())
+    sys.exit(main())

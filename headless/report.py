@@ -28,7 +28,7 @@ import json
 import sys
 from pathlib import Path
 
-from .cli import UserError
+from .errors import UserError
 from .figures import write_aggregate
 from .heatmaps import HeatSums, write_heatmaps
 from .readme import readme
@@ -111,15 +111,10 @@ def write_report(directory: str | Path, *, figures: bool = True) -> list[Path]:
 
 def cmd_report(args: argparse.Namespace) -> int:
     """``stealth report DIR``: write the report files into DIR and list them on stderr."""
-    from .sweep import user_error
-
     directory = Path(args.dir)
-    try:
-        if not directory.is_dir():
-            raise UserError(f"{directory}: no such results directory")
-        written = write_report(directory)
-    except UserError as error:
-        return user_error(error)
+    if not directory.is_dir():
+        raise UserError(f"{directory}: no such results directory")
+    written = write_report(directory)
     pngs = sum(1 for p in written if p.suffix == ".png")
     print(f"stealth: wrote {len(written)} files ({pngs} figures) into {directory}; "
           f"start with {directory / 'README.md'}", file=sys.stderr)

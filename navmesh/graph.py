@@ -602,7 +602,7 @@ def available_bytes() -> int | None:
 
 def check_fits(level: Level, source: str) -> None:
     """Raise a one-line :class:`~navmesh.level.LevelError` if the level cannot run here."""
-    from .level import LevelError
+    from .errors import LevelError
 
     nodes, need = estimate_bytes(level)
     have = available_bytes()

@@ -35,6 +35,8 @@ from shapely.geometry import Polygon
 from shapely.geometry.base import BaseGeometry
 from shapely.geometry.polygon import orient
 
+from navmesh.errors import LevelError
+
 __all__ = [
     "FORMAT",
     "LEVELS_DIR",
@@ -111,24 +113,6 @@ _ARRAY_TYPES = (list, tuple)
 _NUMBER_TYPES = (int, float, np.integer, np.floating)
 
 Point = tuple[float, float]
-
-
-class LevelError(ValueError):
-    """A level file is missing, unreadable or invalid.
-
-    ``str(error)`` is one line, ``"<file>: <field>: <problem>"``; the three parts are also
-    available as ``source``, ``field`` and ``problem``. The exception pickles (it is raised
-    inside worker processes too).
-    """
-
-    def __init__(self, source: str, field: str, problem: str) -> None:
-        super().__init__(source, field, problem)
-        self.source = _one_line(source)
-        self.field = _one_line(field)
-        self.problem = _one_line(problem)
-
-    def __str__(self) -> str:
-        return f"{self.source}: {self.field}: {self.problem}"
 
 
 @dataclass(frozen=True, eq=False)

@@ -24,6 +24,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from navmesh.errors import OutsideError
 from navmesh.funnel import funnel
 from navmesh.sight import MeshSight
 
@@ -34,10 +35,6 @@ __all__ = ["MAX_CORNERS", "NavPath", "OutsideError", "PathQuery"]
 
 #: Above this many wall corners the exact-path tables are not built (A* + funnel instead).
 MAX_CORNERS = 1000
-
-
-class OutsideError(ValueError):
-    """A query point lies outside the walkable area."""
 
 
 @dataclass

@@ -100,7 +100,7 @@ def tiled_level_data(path: Path, source: str) -> tuple[dict[str, Any], dict[str,
         _fail(source, outline_objects[1][0], "a second object of class 'outline'; "
                                              "a map has at most one")
     if not tmap.infinite:
-        x0, y0, x1, y1 = 0, 0, tmap.map_size.width, tmap.map_size.height
+        x0, y0, x1, y1 = 0, 0, int(tmap.map_size.width), int(tmap.map_size.height)
     else:
         x0, y0, x1, y1 = _content_bounds(found, outline_objects, tile, source)
     shift = (x0 * tile, y0 * tile)  # pixels; whole tiles so the grid stays the tile grid
@@ -214,7 +214,7 @@ def _collect(
         name = f"{parent}{layer.name}"
         lx, ly = ox + float(layer.offset.x), oy + float(layer.offset.y)
         if isinstance(layer, tl.LayerGroup):
-            _collect(layer.layers, f"{name}/", lx, ly, found, src)
+            _collect(layer.layers or [], f"{name}/", lx, ly, found, src)
         elif isinstance(layer, tl.TileLayer):
             if WALLS in (layer.name.strip().lower(), _class_of(layer)):
                 cols, rows = _nonzero_tiles(layer, name, src)
@@ -227,7 +227,8 @@ def _collect(
 
 def _nonzero_tiles(layer: tl.TileLayer, name: str, src: str) -> tuple[np.ndarray, np.ndarray]:
     """Tile columns and rows (layer coordinates) of the layer's non-zero gids."""
-    blocks = [(0, 0, layer.data)] if layer.data is not None else []
+    blocks: list[tuple[float, float, list[list[int]]]] = (
+        [(0, 0, layer.data)] if layer.data is not None else [])
     blocks += [(c.coordinates.x, c.coordinates.y, c.data) for c in layer.chunks or []]
     cols, rows = [], []
     for x0, y0, data in blocks:

@@ -90,3 +90,57 @@ def test_sim_json_is_the_only_stdout_and_trace_lines(tmp_path) -> None:
         assert isinstance(line["events"], list)
     explained = [line["explain"] for line in lines[1:] if line.get("explain")]
     assert explained, "PF decisions are explained in the trace"
+
+
+def test_argparse_mistakes_are_the_same_one_line_error(capsys: pytest.CaptureFixture) -> None:
+    for argv in (["bogus"], ["sim"], ["run", "--workers", "two"], ["levels", "--no-such"]):
+        assert main(argv) == 2
+        captured = capsys.readouterr()
+        lines = captured.err.splitlines()
+        assert len(lines) == 1 and lines[0].startswith("stealth: error: "), captured.err
+        assert "usage:" not in captured.err and captured.out == ""
+
+
+def test_version_and_presets(capsys: pytest.CaptureFixture) -> None:
+    from importlib.metadata import version
+
+    with pytest.raises(SystemExit) as info:
+        main(["--version"])
+    assert info.value.code == 0
+    assert capsys.readouterr().out.strip() == f"stealth {version('stealthfield')}"
+    assert main(["presets"]) == 0
+    lines = capsys.readouterr().out.splitlines()
+    quick = next(line for line in lines if line.startswith("quick "))
+    assert "1,000 trials" in quick and {line.split()[0] for line in lines} >= {"smoke", "paper"}
+    assert main(["presets", "--json"]) == 0
+    listed = json.loads(capsys.readouterr().out)
+    assert {"name": "smoke", "description": listed[-1]["description"]} == listed[-1]
+
+
+@pytest.mark.parametrize("command", ["levels", "validate", "path", "sim", "mechanics",
+                                     "presets", "run", "report", "play", "replay"])
+def test_every_option_is_documented_with_its_default(command: str) -> None:
+    from headless.cli import build_parser
+
+    parser = build_parser()
+    sub = next(a for a in parser._actions if isinstance(a, type(parser._subparsers._actions[-1]))
+               ).choices[command]
+    text = sub.format_help()
+    for action in sub._actions:
+        assert action.help, f"{command} {action.dest}: no help"
+        shown = action.default not in (None, False, [])
+        if shown and action.dest != "help":
+            assert f"(default: {action.default})" in " ".join(text.split()), (command, action.dest)
+
+
+def test_play_help_lists_the_keys_without_importing_pygame() -> None:
+    code = ("import sys; from headless.cli import main\n"
+            "try:\n    main(['play', '--help'])\nexcept SystemExit:\n    pass\n"
+            "assert 'pygame' not in sys.modules, 'pygame was imported'\n")
+    result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                            timeout=60)
+    assert result.returncode == 0, result.stderr
+    from game.front.keys import KEY_HELP
+
+    for keys, what in KEY_HELP:
+        assert keys in result.stdout and what in result.stdout

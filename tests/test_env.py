@@ -148,7 +148,7 @@ def test_guard_agents_move_as_told_and_see_fields() -> None:
     for _ in range(6):
         obs, rewards, *_ = env.step({"player": 0, "guard_0": 1, "guard_1": 4})
         assert rewards["guard_0"] == -rewards["player"]
-    side = (2 * env.match.radius + 1) ** 2
+    side = (2 * env.match.observer.radius + 1) ** 2
     confidence = obs["guard_0"][4 * side:5 * side]
     assert confidence.max() > 0  # the team's confidence field is observed
 

@@ -59,7 +59,8 @@ def test_trials_do_not_depend_on_the_graph_storage(
 def test_a_level_too_big_for_the_machine_is_refused_in_one_line(
     monkeypatch: pytest.MonkeyPatch,
 ) -> None:
-    from navmesh.level import LevelError, load_level
+    from navmesh.errors import LevelError
+    from navmesh.level import load_level
 
     level = load_level("maze")
     graph_module.check_fits(level, "maze")  # fits

@@ -20,7 +20,8 @@ from headless.report import (
     write_report,
 )
 from headless.store import ResultStore
-from headless.sweep import load_preset, run_sweep
+from headless.presets import load_preset
+from headless.sweep import run_sweep
 from navmesh.graph import graph_for
 from navmesh.level import load_level
 

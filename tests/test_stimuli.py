@@ -52,12 +52,28 @@ def view(graph: NodeGraph, t: float, guards=(), events=(), active=None) -> World
     )
 
 
-class Hooks:
-    """A stand-in guard AI exposing both hooks, recording what the set assigns."""
+class Hooks(GuardAI):
+    """A stand-in guard AI hearing the stimuli, recording what the set assigns."""
 
     def __init__(self, n: int) -> None:
+        super().__init__()
         self.extra_information = np.zeros(n)
         self.information_weight_floor = 0.0
+
+    def reset(self, graph, rng, n_guards) -> None:
+        pass
+
+    def decide(self, i, view) -> int:
+        return 0
+
+    def hears_stimuli(self) -> bool:
+        return True
+
+    def set_extra_information(self, layer) -> None:
+        self.extra_information = layer
+
+    def set_information_weight_floor(self, floor) -> None:
+        self.information_weight_floor = floor
 
 
 class StayGuards(GuardAI):
@@ -286,7 +302,7 @@ def test_modes_without_hooks_are_left_alone():
     guards.reset(graph, np.random.default_rng(0), 1)
     stimuli = StimulusSet(graph, guard_ai=guards)
     stimuli.tick(view(graph, 1.0, events=[Event("sprint", 0, 1.0)]), 1.0)
-    assert len(stimuli) == 1 and not hasattr(guards, "extra_information")
+    assert len(stimuli) == 1 and not guards.hears_stimuli() and guards.fields() == {}
 
 
 def test_a_layer_of_the_wrong_shape_is_a_clear_error():

@@ -16,11 +16,13 @@ from typing import Any
 import pytest
 
 from game.trial import TrialSpec
-from headless import sweep
+from headless import executors
 from headless.cli import main
 from headless.report import write_report
 from headless.store import ResultStore
-from headless.sweep import Progress, load_preset, run_sweep
+from headless.presets import load_preset
+from headless.progress import Progress
+from headless.sweep import run_sweep
 
 ROOT = Path(__file__).resolve().parent.parent
 
@@ -260,14 +262,14 @@ def test_failed_trial_is_recorded_the_sweep_goes_on_and_a_rerun_retries_it(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str],
 ) -> None:
     preset_path = write_preset(tmp_path, seeds=2, duration=5.0)
-    real = sweep.run_trial
+    real = executors.run_trial
 
     def flaky(spec: TrialSpec) -> dict[str, Any]:
         if spec.guards == "random" and spec.seed == 1:
             raise RuntimeError("simulated crash")
         return real(spec)
 
-    monkeypatch.setattr(sweep, "run_trial", flaky)
+    monkeypatch.setattr(executors, "run_trial", flaky)
     out = tmp_path / "out"
     assert main(["run", "--preset", str(preset_path), "--out", str(out), "--workers", "1"]) == 1
     err = capsys.readouterr().err
@@ -278,7 +280,7 @@ def test_failed_trial_is_recorded_the_sweep_goes_on_and_a_rerun_retries_it(
         assert "RuntimeError: simulated crash" in failed["error"]
         assert "Traceback" in failed["error"]
 
-    monkeypatch.setattr(sweep, "run_trial", real)
+    monkeypatch.setattr(executors, "run_trial", real)
     assert main(["run", "--preset", str(preset_path), "--out", str(out), "--workers", "1"]) == 0
     assert "2 finished, 0 failed, 6 skipped" in capsys.readouterr().err
     with ResultStore(out / "results.sqlite", readonly=True) as store:
@@ -289,7 +291,7 @@ def test_ctrl_c_keeps_committed_trials_and_says_how_to_resume(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str],
 ) -> None:
     preset_path = write_preset(tmp_path, seeds=3, duration=5.0)
-    real, calls = sweep.run_trial, []
+    real, calls = executors.run_trial, []
 
     def interrupted(spec: TrialSpec) -> dict[str, Any]:
         calls.append(spec)
@@ -297,7 +299,7 @@ def test_ctrl_c_keeps_committed_trials_and_says_how_to_resume(
             raise KeyboardInterrupt
         return real(spec)
 
-    monkeypatch.setattr(sweep, "run_trial", interrupted)
+    monkeypatch.setattr(executors, "run_trial", interrupted)
     out = tmp_path / "out"
     code = main(["run", "--preset", str(preset_path), "--out", str(out), "--workers", "1"])
     assert code == 130
@@ -351,7 +353,7 @@ def test_progress_redraws_on_a_terminal_and_prints_lines_otherwise() -> None:
 
 
 def test_workers_import_neither_pygame_nor_trimesh_nor_matplotlib() -> None:
-    code = ("import sys; from game.trial import TrialSpec; from headless.sweep import run_batch; "
+    code = ("import sys; from game.trial import TrialSpec; from headless.executors import run_batch; "
             "rows = run_batch([TrialSpec('maze', 'grid', 'cheat', 'evade', 'capture', 0, "
             "(('world.duration', 2.0),))]); assert 'error' not in rows[0], rows[0]; "
             "print([m for m in ('pygame', 'trimesh', 'matplotlib') if m in sys.modules])")
@@ -367,14 +369,14 @@ def test_a_dying_worker_stops_the_sweep_and_keeps_finished_trials(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str],
 ) -> None:
     preset_path = write_preset(tmp_path, seeds=6, duration=5.0)
-    real = sweep.run_trial
+    real = executors.run_trial
 
     def dies(spec: TrialSpec) -> dict[str, Any]:
         if spec.seed == 5:
             os._exit(3)  # a crash no exception handler sees (segfault, OOM kill)
         return real(spec)
 
-    monkeypatch.setattr(sweep, "run_trial", dies)
+    monkeypatch.setattr(executors, "run_trial", dies)
     out = tmp_path / "out"
     assert main(["run", "--preset", str(preset_path), "--out", str(out), "--workers", "2"]) == 1
     err = capsys.readouterr().err

@@ -34,20 +34,20 @@ from game.front.render import (
     pygame,
     save_screenshot,
 )
+from game.errors import FrontError
+from game.front.keys import KEY_HELP, MODE_ORDER
 from game.scene import OVERLAYS, Scene, SceneBuilder, overlay_key
+from game.world import World
 
 #: Guard modes on the number keys, in the order of SPEC §9.
-MODE_KEYS: dict[int, str] = {
-    pygame.K_1: "pf", pygame.K_2: "random", pygame.K_3: "fsm",
-    pygame.K_4: "staleness", pygame.K_5: "cheat",
-}
+MODE_KEYS: dict[int, str] = {pygame.K_1 + i: mode for i, mode in enumerate(MODE_ORDER)}
 
-#: Stealth mechanics: World method, help label. Wired only if the world has the method.
-MECHANICS: dict[str, str] = {
-    "throw_decoy": "click throw decoy",
-    "activate_decoy": "E activate decoy",
-    "take_down": "F take down",
-    "toggle_rain": "R rain",
+#: Stealth mechanics: the World method each input calls, and the label of its messages.
+MECHANICS: dict[str, tuple[Callable[..., Any], str]] = {
+    "throw_decoy": (World.throw_decoy, "throw decoy"),
+    "activate_decoy": (World.activate_decoy, "activate decoy"),
+    "take_down": (World.take_down, "take down"),
+    "toggle_rain": (World.toggle_rain, "rain"),
 }
 
 _MOVE_KEYS: tuple[tuple[int, float, float], ...] = (
@@ -84,9 +84,10 @@ class PlayGame(FrameLoop):
     ``lockstep=True`` advances exactly one physics step per :meth:`frame`; otherwise the
     world follows the wall clock.
 
-    >>> # doctest: +SKIP
-    >>> game = PlayGame(PlaySettings("miami", autopilot="maxmin", overlay="K"), lockstep=True)
-    >>> times = game.run(frames=120)
+    Usage (opens a window)::
+
+        game = PlayGame(PlaySettings("miami", autopilot="maxmin", overlay="K"), lockstep=True)
+        times = game.run(frames=120)
     """
 
     def __init__(
@@ -123,7 +124,7 @@ class PlayGame(FrameLoop):
         _freeze_heap()
 
     # ------------------------------------------------------------------ world
-    def _build_world(self, mode: str) -> Any:
+    def _build_world(self, mode: str) -> World:
         from game.trial import TrialSpec, make_world
 
         self.mode = mode
@@ -152,26 +153,15 @@ class PlayGame(FrameLoop):
 
     # ------------------------------------------------------------------ input
     def help_items(self) -> list[str]:
-        """The help line: every key, with mechanics the world lacks marked n/a."""
-        items = ["WASD/arrows move", "Shift sprint"]
-        for method, label in MECHANICS.items():
-            items.append(label if callable(getattr(self.world, method, None)) else f"{label} (n/a)")
-        items += [
-            "Space pause", "O/Tab overlay", "M mesh/grid", "G plans",
-            "1-5 guards pf/random/fsm/staleness/cheat", "Enter restart", "Esc quit",
-        ]
-        return items
+        """The help line: every key of :data:`game.front.keys.KEY_HELP`, shortly."""
+        return [f"{keys} {what.split(' (')[0]}" for keys, what in KEY_HELP]
 
     def _mechanic(self, method: str, *args: float) -> None:
-        label = MECHANICS[method].split(" ", 1)[1]
-        action: Callable[..., Any] | None = getattr(self.world, method, None)
-        if not callable(action):
-            self.flash(f"{label}: not available")
-            return
+        action, label = MECHANICS[method]
         if self.world.done:
             return
         try:
-            result = action(*args)
+            result = action(self.world, *args)
         except (ValueError, RuntimeError) as error:
             self.flash(f"{label}: {error}", BAD)
             return
@@ -200,7 +190,8 @@ class PlayGame(FrameLoop):
         elif key == pygame.K_SPACE:
             self.paused = not self.paused
         elif key in (pygame.K_o, pygame.K_TAB):
-            self.overlay = OVERLAYS[(OVERLAYS.index(self.overlay) + 1) % len(OVERLAYS)]
+            keys = list(OVERLAYS)
+            self.overlay = keys[(keys.index(self.overlay) + 1) % len(keys)]
         elif key == pygame.K_m:
             self.show_mesh = not self.show_mesh
         elif key == pygame.K_g:
@@ -313,25 +304,21 @@ def lockstep_wanted(frames: int | None) -> bool:
 
 def open_display() -> None:
     """Initialise the display or fail with a one-line user error."""
-    from headless.cli import UserError
-
     try:
         init_pygame()
     except pygame.error as error:
-        raise UserError(
+        raise FrontError(
             f"cannot open a window ({error}); for a headless run set SDL_VIDEODRIVER=dummy"
         ) from None
 
 
 def finish(surface: pygame.Surface, screenshot: str | None, times: Sequence[float]) -> None:
     """Save the screenshot (if asked) and report the frame count and times on stderr."""
-    from headless.cli import UserError
-
     if screenshot:
         try:
             save_screenshot(surface, screenshot)
         except OSError as error:
-            raise UserError(f"--screenshot {screenshot}: cannot write ({error})") from None
+            raise FrontError(f"--screenshot {screenshot}: cannot write ({error})") from None
     if times:
         ordered = sorted(times)
         median = ordered[len(ordered) // 2] * 1000
@@ -342,24 +329,23 @@ def finish(surface: pygame.Surface, screenshot: str | None, times: Sequence[floa
 
 def cmd_play(args: argparse.Namespace) -> int:
     """``stealth play LEVEL``: see the module docstring and docs/play.md."""
-    from headless.cli import UserError
     from navmesh.level import load_level
 
     load_level(args.level)  # a bad level fails here with its one-line message
     try:
         overlay = overlay_key(args.overlay)
     except ValueError as error:
-        raise UserError(f"--overlay: {error}") from None
+        raise FrontError(f"--overlay: {error}") from None
     if args.frames is not None and args.frames < 1:
-        raise UserError(f"--frames: expected a positive number of frames, got {args.frames}")
+        raise FrontError(f"--frames: expected a positive number of frames, got {args.frames}")
     from game.config import Config
 
     Config.load({"world.spawns": "level"}).with_overrides(args.set)  # bad --set: one line
     settings = PlaySettings(
         level=args.level, guards=args.guards, abstraction=args.abstraction,
-        scenario=getattr(args, "scenario", "capture"), seed=args.seed,
+        scenario=args.scenario, seed=args.seed,
         overrides=tuple(args.set), autopilot=args.autopilot, overlay=overlay,
-        show_mesh=bool(getattr(args, "mesh", False)), show_plans=bool(getattr(args, "plans", False)),
+        show_mesh=args.mesh, show_plans=args.plans,
     )
     open_display()
     game = PlayGame(settings, lockstep=lockstep_wanted(args.frames))

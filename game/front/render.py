@@ -129,9 +129,10 @@ class Layout:
 class Renderer:
     """Draws scenes of one :class:`StaticScene` onto a Surface of a given size.
 
-    >>> # doctest: +SKIP
-    >>> renderer = Renderer(builder.static, (900, 700))
-    >>> renderer.draw(screen, builder.from_world(world, "K"), DrawOptions(show_plans=True))
+    Usage (needs a pygame display)::
+
+        renderer = Renderer(builder.static, (900, 700))
+        renderer.draw(screen, builder.from_world(world, "K"), DrawOptions(show_plans=True))
     """
 
     HUD_HEIGHT = 50

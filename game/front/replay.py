@@ -310,7 +310,7 @@ class ReplayViewer(FrameLoop):
 def cmd_replay(args: argparse.Namespace) -> int:
     """``stealth replay TRACE [--level LEVEL]``: see the module docstring and docs/play.md."""
     from game.front.play import finish, lockstep_wanted, open_display
-    from headless.cli import UserError
+    from game.errors import FrontError as UserError
     from navmesh.graph import graph_for
     from navmesh.level import load_level
 

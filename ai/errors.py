@@ -1,0 +1,19 @@
+"""Errors of the ``ai`` layer, subclasses of the root :class:`~navmesh.errors.StealthError`.
+
+>>> issubclass(UnknownNameError, StealthError)
+True
+"""
+
+from __future__ import annotations
+
+from navmesh.errors import StealthError
+
+__all__ = ["StealthError", "StimulusError", "UnknownNameError"]
+
+
+class UnknownNameError(StealthError, ValueError):
+    """A guard mode or player policy name that is not registered; the message lists the names."""
+
+
+class StimulusError(StealthError, ValueError):
+    """A stimulus plugin that cannot be loaded; the message is one line naming it."""

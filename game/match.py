@@ -1,0 +1,281 @@
+"""One environment's match: the world, the agents' controllers, their rewards and frames.
+
+Shared by both environments of :mod:`game.env`. The player and externally controlled
+guards are controllers (:class:`ExternalPlayer`, :class:`ExternalGuards`) that answer the
+world's decisions with the node the agent's action points to; one :meth:`Match.step` is
+one player move.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping
+from typing import Any
+
+import numpy as np
+from gymnasium import spaces
+
+from ai import make_guard_ai
+from ai.pf import PotentialFieldGuards
+from ai.view import PlayerPolicy, WorldView
+from navmesh.graph import NodeGraph, graph_for
+from navmesh.level import cached_level
+
+from .config import Config
+from .observations import OBS_BOUND, Observer
+from .trial import TrialSpec, trial_rngs
+from .world import World
+
+__all__ = ["ExternalGuards", "ExternalPlayer", "GRID_ACTIONS", "Match", "PARTITION_ACTIONS",
+           "REWARDS"]
+
+#: Grid actions (Discrete(5)): stay and the four neighbouring cells (y grows downwards).
+GRID_ACTIONS = ("stay", "north", "east", "south", "west")
+#: Partition actions (Discrete(9)): stay and eight compass directions.
+PARTITION_ACTIONS = ("stay", "north", "northeast", "east", "southeast",
+                     "south", "southwest", "west", "northwest")
+#: Default reward terms (see docs/api.md, "Rewards").
+REWARDS = {"survival": 0.1, "hp": 1.0, "capture": 10.0}
+
+
+def _direction_table(graph: NodeGraph) -> np.ndarray:
+    """``moves[node, action]``: the node an action leads to from ``node`` (itself if none).
+
+    Grid: the neighbouring cell in that direction. Partition: among the nodes one or two
+    hops away, the farthest along the direction within 45° of it (67.5° if none is), so
+    an action covers about one grid move's worth of corridor even across small triangles.
+    """
+    n = graph.n
+    pos = graph.positions
+    if graph.kind == "grid":
+        units = np.array([(0, 0), (0, -1), (1, 0), (0, 1), (-1, 0)], dtype=float)
+    else:
+        angles = -np.pi / 2 + np.arange(8) * np.pi / 4  # north first, clockwise (y down)
+        units = np.vstack([[0.0, 0.0], np.stack([np.cos(angles), np.sin(angles)], axis=1)])
+    moves = np.repeat(np.arange(n)[:, None], len(units), axis=1)
+    for node in range(n):
+        if graph.kind == "grid":
+            options = np.asarray(graph.neighbors[node])
+        else:
+            hops = graph.hops_from(node, max_hops=2)
+            options = np.flatnonzero((hops >= 1) & (hops <= 2))
+        if not len(options):
+            continue
+        delta = pos[options] - pos[node]
+        length = np.hypot(delta[:, 0], delta[:, 1])
+        for a in range(1, len(units)):
+            along = delta @ units[a]
+            cos = along / np.maximum(length, 1e-12)
+            for limit in (math.cos(math.pi / 4) - 1e-9, math.cos(3 * math.pi / 8)):
+                ok = cos >= limit
+                if ok.any():
+                    moves[node, a] = int(options[ok][np.argmax(along[ok])])
+                    break
+    return moves
+
+
+class ExternalPlayer(PlayerPolicy):
+    """The player as an env agent: each decision goes where the current action points.
+
+    It counts its decisions so the env can tell when the move it asked for has begun.
+    """
+
+    policy = "external"
+
+    def __init__(self, moves: np.ndarray) -> None:
+        super().__init__()
+        self.moves = moves
+        self.action = 0
+        self.decisions = 0
+        self.target = -1
+
+    def reset(self, graph: NodeGraph, rng: np.random.Generator) -> None:
+        self.action, self.decisions, self.target = 0, 0, -1
+
+    def decide(self, view: WorldView) -> int:
+        self.decisions += 1
+        self.target = int(self.moves[view.player_node, self.action])
+        return self.target
+
+
+class ExternalGuards(PotentialFieldGuards):
+    """Guards whose moves come from env actions, one per guard.
+
+    It still advances the team's shared potential fields on every AI tick exactly as the
+    ``pf`` guards would (sightings, confidence, stimuli hooks), only to show them to the
+    guard agents in their observations; the decisions ignore the fields.
+    """
+
+    mode = "external"
+
+    def __init__(self, moves: np.ndarray, params: Mapping[str, Any] | None = None) -> None:
+        super().__init__(params)
+        self.moves = moves
+        self.actions = np.zeros(0, dtype=np.int64)
+
+    def reset(self, graph: NodeGraph, rng: np.random.Generator, n_guards: int) -> None:
+        super().reset(graph, rng, n_guards)
+        self.actions = np.zeros(n_guards, dtype=np.int64)
+
+    def decide(self, i: int, view: WorldView) -> int:
+        return int(self.moves[view.guard_nodes[i], self.actions[i]])
+
+    def state_name(self, i: int) -> str:
+        return self.mode
+
+
+class Match:
+    """One env's world, controllers, observation encoders, rewards and renderer.
+
+    Shared by both environments; ``guard_mode=None`` means the guards are agents.
+    """
+
+    def __init__(self, level: str, abstraction: str, scenario: str, guard_mode: str | None,
+                 overrides: Mapping[str, Any], obs_radius: int = 4,
+                 rewards: Mapping[str, float] | None = None,
+                 render_mode: str | None = None,
+                 render_size: tuple[int, int] | None = None) -> None:
+        if abstraction not in ("grid", "partition"):
+            raise ValueError(f"unknown abstraction {abstraction!r} (choose grid or partition)")
+        if render_mode not in (None, "rgb_array", "human"):
+            raise ValueError(f"unknown render_mode {render_mode!r} (choose rgb_array or human)")
+        unknown = set(rewards or {}) - set(REWARDS)
+        if unknown:
+            raise ValueError(f"unknown reward terms {sorted(unknown)} (choose from {list(REWARDS)})")
+        self.level = cached_level(level)
+        self.abstraction, self.scenario, self.guard_mode = abstraction, scenario, guard_mode
+        self.overrides = dict(overrides)
+        self.config = Config.load(self.overrides)
+        self.graph = graph_for(self.level, abstraction)
+        self.moves = _direction_table(self.graph)
+        self.n_actions = self.moves.shape[1]
+        self.rewards = {**REWARDS, **(rewards or {})}
+        self.render_mode, self.render_size = render_mode, render_size
+        cfg = self.config
+        self.dt = float(cfg["world.physics_step"])
+        self.duration = float(cfg["world.duration"])
+        self.hp_max = float(cfg["world.player_hp"])
+        self.view_range = float(cfg["world.view_range"]) * float(
+            cfg[f"scenario.{scenario}.view_range_scale"])
+        speed = float(cfg["world.player_speed"]) * float(
+            cfg[f"scenario.{scenario}.player_speed_scale"])
+        #: physics steps a "stay" lasts: as long as a move along a mean edge takes
+        self.hold_steps = max(1, math.ceil(self.graph.mean_edge_length / speed / self.dt - 1e-9))
+        self.max_steps = max(self.hold_steps, math.ceil(2 * float(cfg["world.stuck_timeout"]) / self.dt))
+
+        self.seed: int | None = None
+        self.world = self._new_world(0)
+        self.n_guards = len(self.world.guards)
+        self.observer = Observer(self.level, self.graph, obs_radius, self.view_range,
+                                 self.duration, self.hp_max, self.n_guards)
+        self._renderer: Any = None
+
+    # ------------------------------------------------------------------ episodes
+    def _new_world(self, seed: int) -> World:
+        self.player = ExternalPlayer(self.moves)
+        if self.guard_mode is None:
+            self.guards: ExternalGuards | None = ExternalGuards(self.moves, self.config.section("pf"))
+            guard_ai: Any = self.guards
+        else:
+            self.guards = None
+            guard_ai = make_guard_ai(self.guard_mode, self.config.section(self.guard_mode))
+        spec = TrialSpec(level=self.level.name, abstraction=self.abstraction,
+                         guards=self.guard_mode or "external", player="external",
+                         scenario=self.scenario, seed=seed)
+        return World(self.level, self.abstraction, guard_ai, self.player, config=self.config,
+                     scenario=self.scenario, rngs=trial_rngs(spec, self.level.name),
+                     graph=self.graph)
+
+    def reset(self, seed: int | None, fallback: np.random.Generator) -> dict[str, Any]:
+        """Start the episode of trial seed ``seed`` (or the next one); return its info."""
+        if seed is not None:
+            self.seed = int(seed)
+        elif self.seed is None:
+            self.seed = int(fallback.integers(2**31))
+        else:
+            self.seed += 1
+        self.world = self._new_world(self.seed)
+        return self.info()
+
+    def info(self) -> dict[str, Any]:
+        w = self.world
+        return {"seed": self.seed, "t": round(w.t, 6), "hp": round(w.hp, 6),
+                "captures": w.metrics()["captures"]}
+
+    def step(self, player_action: int, guard_actions: np.ndarray | None = None
+             ) -> tuple[float, bool, bool]:
+        """Play one player move; return (player reward, terminated, truncated)."""
+        w = self.world
+        if w.done:
+            raise RuntimeError("step() after the episode ended: call reset()")
+        self.player.action, self.player.decisions = int(player_action), 0
+        if self.guards is not None and guard_actions is not None:
+            self.guards.actions[:] = guard_actions
+        hp0, t0, caps0 = w.hp, w.t, w.metrics()["captures"]
+        staying = False
+        hp = hp0
+        for k in range(self.max_steps):
+            w.step()
+            if w.done or w.hp > hp:  # over, or respawned after a capture (fixed-time)
+                break
+            hp = w.hp
+            if self.player.decisions == 1 and k == 0:
+                staying = self.player.target == w.player.node and self._at(self.player.target)
+            if self.player.decisions:
+                if staying:
+                    if k + 1 >= self.hold_steps:
+                        break
+                elif self.player.decisions > 1 or self._at(self.player.target):
+                    break
+        captures = w.metrics()["captures"] - caps0
+        ends = bool(self.config[f"scenario.{self.scenario}.end_on_capture"])
+        if captures and not ends:  # fixed-time: the player respawned with full HP
+            lost = hp0 + (captures - 1) * self.hp_max + (self.hp_max - w.hp)
+        else:
+            lost = hp0 - max(0.0, w.hp)
+        reward = (self.rewards["survival"] * (w.t - t0) - self.rewards["hp"] * lost
+                  - self.rewards["capture"] * captures)
+        terminated = bool(w.done and captures and ends)
+        truncated = bool(w.done and not terminated)
+        return float(reward), terminated, truncated
+
+    def _at(self, node: int) -> bool:
+        x, y = self.world.player.pos
+        px, py = self.graph.positions[node]
+        return math.hypot(x - px, y - py) <= 1e-3
+
+    # ------------------------------------------------------------------ rendering
+    def observe_player(self) -> np.ndarray:
+        """The player's observation now (layout: docs/api.md, "Observations")."""
+        return self.observer.observe_player(self.world, self.world.view())
+
+    def observe_guard(self, view: WorldView, i: int) -> np.ndarray:
+        """Guard ``i``'s observation of ``view``: what the team knows plus its fields."""
+        return self.observer.observe_guard(self.world, view, i, self.guards)
+
+    def obs_space(self, guard: bool) -> spaces.Box:
+        return spaces.Box(-OBS_BOUND, OBS_BOUND, shape=(self.observer.obs_size(guard),),
+                          dtype=np.float32)
+
+    # ------------------------------------------------------------------ rendering
+    def render(self) -> np.ndarray | None:
+        """Draw the world with the game's renderer: an RGB array, or into a window."""
+        if self.render_mode is None:
+            return None
+        if self._renderer is None:
+            # lazy: only rendering imports pygame (game.front); the core never does
+            from game.front.frames import FrameRenderer  # noqa: PLC0415
+            from game.scene import SceneBuilder  # noqa: PLC0415
+
+            builder = SceneBuilder(self.level, self.graph, view_range=self.view_range,
+                                   fov_deg=float(self.config["world.fov_deg"]))
+            self._renderer = FrameRenderer(builder, self.render_mode, self.render_size,
+                                           title=f"Stealthfield — {self.level.name}")
+        return self._renderer.draw(self.world)
+
+    def close(self) -> None:
+        if self._renderer is not None:
+            self._renderer.close()
+            self._renderer = None
+
+

@@ -1,0 +1,162 @@
+"""Observations of the environments' agents: fixed-shape float32 arrays (docs/api.md).
+
+A window of ``(2r+1)²`` cells around the agent (channels :data:`PLAYER_CHANNELS` or
+:data:`GUARD_CHANNELS`) followed by the agent's own features and what it knows of the
+others; every entry lies in ``[-OBS_BOUND, OBS_BOUND]``.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+import shapely
+from shapely.geometry import LineString
+
+from ai.pf import PotentialFieldGuards
+from ai.view import WorldView
+from navmesh.graph import NodeGraph
+from navmesh.level import Level
+
+if TYPE_CHECKING:
+    from .world import World
+
+__all__ = ["GUARD_CHANNELS", "GUARD_FEATURES", "OBS_BOUND", "OTHER_GUARD", "Observer",
+           "PLAYER_AS_SEEN", "PLAYER_CHANNELS", "PLAYER_FEATURES", "active_guards"]
+
+#: Every observation entry lies in [-OBS_BOUND, OBS_BOUND] (most in [-1, 1]).
+OBS_BOUND = 10.0
+#: Names of the window channels of a player's / a guard's observation.
+PLAYER_CHANNELS = ("walkable", "player", "guards")
+GUARD_CHANNELS = ("walkable", "player", "guards", "information", "confidence")
+PLAYER_FEATURES = ("x", "y", "cos_heading", "sin_heading", "hp", "time", "detected")
+GUARD_FEATURES = ("x", "y", "cos_heading", "sin_heading", "player_hp", "time", "sees_player")
+OTHER_GUARD = ("known", "dx", "dy", "cos_heading", "sin_heading")
+PLAYER_AS_SEEN = ("known", "dx", "dy")
+
+
+def active_guards(view: WorldView) -> np.ndarray:
+    """Which guards are in play (all of them when the view does not say)."""
+    if view.guard_active is None:
+        return np.ones(len(view.guard_nodes), dtype=bool)
+    return view.guard_active
+
+
+class Observer:
+    """Encodes what the player or a guard perceives of one level as a flat array."""
+
+    def __init__(self, level: Level, graph: NodeGraph, radius: int, view_range: float,
+                 duration: float, hp_max: float, n_guards: int) -> None:
+        if radius < 0:
+            raise ValueError("obs_radius must be >= 0")
+        self.level, self.radius, self.view_range = level, int(radius), view_range
+        self.duration, self.hp_max, self.n_guards = duration, hp_max, n_guards
+        rows, cols = level.rows, level.cols
+        cs = level.cell_size
+        self.cell_size = cs
+        self.width, self.height = cols * cs, rows * cs
+        self.diagonal = math.hypot(self.width, self.height)
+        r = self.radius
+        self.occupancy = np.pad(level.occupancy.astype(np.float32), r)
+        if graph.cell_node is not None:
+            cell_node = np.asarray(graph.cell_node)
+        else:
+            cell_node = np.full((rows, cols), -1, dtype=np.int64)
+            for row, col in zip(*np.nonzero(level.occupancy), strict=True):
+                cell_node[row, col] = graph.node_at((col + 0.5) * cs, (row + 0.5) * cs)
+        self.cell_node = np.pad(cell_node, r, constant_values=-1)
+        self.walkable = level.walkable
+        shapely.prepare(self.walkable)
+
+    def _cell(self, pos: Any) -> tuple[int, int]:
+        return (min(max(int(pos[1] // self.cell_size), 0), self.level.rows - 1),
+                min(max(int(pos[0] // self.cell_size), 0), self.level.cols - 1))
+
+    def _window(self, centre: Any, channels: int) -> tuple[np.ndarray, int, int]:
+        r = self.radius
+        row, col = self._cell(centre)
+        win = np.zeros((channels, 2 * r + 1, 2 * r + 1), dtype=np.float32)
+        win[0] = self.occupancy[row:row + 2 * r + 1, col:col + 2 * r + 1]
+        return win, row, col
+
+    def _mark(self, win: np.ndarray, channel: int, row: int, col: int, pos: Any) -> None:
+        r = self.radius
+        pr, pc = self._cell(pos)
+        if abs(pr - row) <= r and abs(pc - col) <= r:
+            win[channel, pr - row + r, pc - col + r] += 1.0
+
+    def player_sees(self, view: WorldView, j: int) -> bool:
+        """The player perceives guard ``j`` within view range with a clear line (no cone)."""
+        a, b = view.player_pos, view.guard_positions[j]
+        if not active_guards(view)[j] or math.dist(a, b) > self.view_range:
+            return False
+        return math.dist(a, b) < 1e-9 or bool(self.walkable.covers(LineString([a, b])))
+
+    def _self_features(self, world: World, pos: Any, heading: float, view: WorldView) -> list[float]:
+        return [pos[0] / self.width, pos[1] / self.height, math.cos(heading), math.sin(heading),
+                world.hp / self.hp_max, min(1.0, view.t / self.duration)]
+
+    def _guard_features(self, view: WorldView, origin: Any, known: list[bool]) -> list[float]:
+        out: list[float] = []
+        for j in range(self.n_guards):
+            if known[j]:
+                d = (view.guard_positions[j] - origin) / self.diagonal
+                h = view.guard_headings[j]
+                out += [1.0, d[0], d[1], math.cos(h), math.sin(h)]
+            else:
+                out += [0.0] * len(OTHER_GUARD)
+        return out
+
+    def observe_player(self, world: World, view: WorldView) -> np.ndarray:
+        """The player's observation (layout: docs/api.md, "Observations")."""
+        pos = view.player_pos
+        win, row, col = self._window(pos, len(PLAYER_CHANNELS))
+        self._mark(win, 1, row, col, pos)
+        known = [self.player_sees(view, j) for j in range(self.n_guards)]
+        for j in range(self.n_guards):
+            if known[j]:
+                self._mark(win, 2, row, col, view.guard_positions[j])
+        heading = world.player.heading
+        vec = self._self_features(world, pos, heading, view) + [float(bool(view.seen_by))]
+        vec += self._guard_features(view, pos, known)
+        return self._pack(win, vec)
+
+    def observe_guard(self, world: World, view: WorldView, i: int,
+                      guards: PotentialFieldGuards | None) -> np.ndarray:
+        """Guard ``i``'s observation: what the team knows plus the team's fields."""
+        pos = view.guard_positions[i]
+        win, row, col = self._window(pos, len(GUARD_CHANNELS))
+        team_sees = bool(view.seen_by)
+        if team_sees:
+            self._mark(win, 1, row, col, view.player_pos)
+        for j in range(self.n_guards):
+            if active_guards(view)[j]:
+                self._mark(win, 2, row, col, view.guard_positions[j])
+        if guards is not None:
+            fields = guards.fields()
+            r = self.radius
+            nodes = self.cell_node[row:row + 2 * r + 1, col:col + 2 * r + 1]
+            inside = nodes >= 0
+            info = np.asarray(fields["I"]) + np.asarray(fields["I_extra"])
+            c_scale = guards.config.C0 / max(1e-9, 1.0 - guards.config.rho)
+            win[3][inside] = info[nodes[inside]] / guards.config.I0
+            win[4][inside] = np.asarray(fields["C"])[nodes[inside]] / c_scale
+        vec = self._self_features(world, pos, float(view.guard_headings[i]), view)
+        vec += [float(i in view.seen_by)]
+        vec += self._guard_features(view, pos, [bool(a) for a in active_guards(view)])
+        d = (view.player_pos - pos) / self.diagonal
+        vec += [1.0, d[0], d[1]] if team_sees else [0.0, 0.0, 0.0]
+        return self._pack(win, vec)
+
+    @staticmethod
+    def _pack(win: np.ndarray, vec: list[float]) -> np.ndarray:
+        out = np.concatenate([win.ravel(), np.asarray(vec, dtype=np.float32)])
+        return np.clip(out, -OBS_BOUND, OBS_BOUND).astype(np.float32)
+
+    def obs_size(self, guard: bool) -> int:
+        side = (2 * self.radius + 1) ** 2
+        if guard:
+            return (len(GUARD_CHANNELS) * side + len(GUARD_FEATURES)
+                    + len(OTHER_GUARD) * self.n_guards + len(PLAYER_AS_SEEN))
+        return len(PLAYER_CHANNELS) * side + len(PLAYER_FEATURES) + len(OTHER_GUARD) * self.n_guards

@@ -1,0 +1,105 @@
+"""Executors a sweep maps its trials over: in-process, a process pool, a Dask cluster.
+
+The unit of work is :func:`run_batch` — a few :class:`~game.trial.TrialSpec` in, their rows
+out — a pure, top-level, picklable function, so every ``concurrent.futures.Executor`` runs
+it alike (Mesa's batch runner). A failing trial never raises: it becomes a row with an
+``error`` text, so only the machinery itself (a dead worker, a cluster that cannot import
+the project) makes a task fail. To add an executor, return any ``concurrent.futures``
+executor from a function here and pick it in :func:`headless.sweep.run_sweep`.
+"""
+
+from __future__ import annotations
+
+import concurrent.futures as cf
+import signal
+import traceback
+from collections.abc import Callable, Sequence
+from typing import Any
+
+from game.trial import TrialSpec, run_trial
+
+from .errors import SweepError
+
+__all__ = [
+    "InlineExecutor", "connect_dask", "process_pool", "run_batch", "run_one", "shutdown",
+    "terminate",
+]
+
+
+def run_one(spec: TrialSpec) -> dict[str, Any]:
+    """Run one trial; a trial that raises becomes a row with ``error`` (the traceback)."""
+    try:
+        row = run_trial(spec)
+    except Exception as error:
+        row = {
+            "level": spec.level, "abstraction": spec.abstraction, "guards": spec.guards,
+            "player": spec.player, "scenario": spec.scenario, "seed": spec.seed,
+            "root_seed": spec.root_seed, "overrides": dict(spec.overrides),
+            "error": f"{type(error).__name__}: {error}\n{traceback.format_exc(limit=-8)}"[:8000],
+        }
+    row["key"] = spec.key
+    row["level_ref"] = spec.level
+    return row
+
+
+def run_batch(specs: Sequence[TrialSpec]) -> list[dict[str, Any]]:
+    """Run a few trials in one task (top-level and picklable: any executor can map it)."""
+    return [run_one(spec) for spec in specs]
+
+
+class InlineExecutor(cf.Executor):
+    """``--workers 1``: run each task at submit time in this process (easy to debug)."""
+
+    def submit(self, fn: Callable[..., Any], /, *args: Any, **kwargs: Any) -> cf.Future[Any]:
+        future: cf.Future[Any] = cf.Future()
+        try:
+            future.set_result(fn(*args, **kwargs))
+        except Exception as error:
+            future.set_exception(error)
+        return future
+
+
+def _ignore_sigint() -> None:
+    """Pool worker initializer: Ctrl-C is the main process's business."""
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+
+
+def process_pool(workers: int) -> cf.ProcessPoolExecutor:
+    """A pool of ``workers`` processes that leave Ctrl-C to the main process."""
+    return cf.ProcessPoolExecutor(max_workers=workers, initializer=_ignore_sigint)
+
+
+def connect_dask(scheduler: str) -> tuple[Any, cf.Executor, int]:
+    """A Dask client, its ``concurrent.futures`` executor and its number of threads."""
+    try:
+        import distributed
+    except ImportError:
+        raise SweepError("--scheduler needs Dask: install the cluster extra "
+                         "(pip install 'stealthfield[cluster]')") from None
+    try:
+        client = distributed.Client(scheduler, timeout="10s")
+    except Exception as error:
+        raise SweepError(f"--scheduler {scheduler}: cannot connect "
+                         f"({type(error).__name__}: {error})") from None
+    threads = sum(client.nthreads().values()) or 1
+    return client, client.get_executor(), threads
+
+
+def shutdown(executor: cf.Executor) -> None:
+    """Stop an executor without waiting; a process pool drops its queued tasks too."""
+    if isinstance(executor, cf.ProcessPoolExecutor):
+        executor.shutdown(wait=False, cancel_futures=True)  # no-op after a clean finish
+    else:
+        executor.shutdown(wait=False)
+
+
+def terminate(executor: cf.Executor) -> None:
+    """Stop at once: shut down, and end a process pool's workers that are still busy."""
+    if isinstance(executor, cf.ProcessPoolExecutor):
+        processes = list((executor._processes or {}).values())  # noqa: SLF001 (our own pool)
+        executor.shutdown(wait=False, cancel_futures=True)
+        for process in processes:
+            if process.is_alive():
+                process.terminate()
+    else:
+        executor.shutdown(wait=False)

@@ -1,0 +1,306 @@
+"""Presets: experiment designs in TOML, validated completely before anything runs.
+
+A **preset** is a TOML file (``headless/presets/NAME.toml`` or the user's own) naming the
+levels, abstractions, guard modes, player policies, scenarios and seeds of a full factorial
+design, an optional ``root_seed``, an optional ``[set]`` table of config overrides and a
+one-line ``description``. :func:`load_preset` turns one into a :class:`Preset` whose
+:meth:`Preset.specs` lists every trial in the sweep's order; every mistake is a one-line
+:class:`~headless.errors.PresetError` naming the file and field.
+
+>>> [name for name, _ in bundled_presets()][:2]
+['paper', 'paper-pf-literal']
+"""
+
+from __future__ import annotations
+
+import tomllib
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from game.trial import TrialSpec
+
+from .errors import PresetError
+
+__all__ = [
+    "PRESETS_DIR", "Preset", "bundled_preset_names", "bundled_presets", "load_preset",
+    "parse_preset",
+]
+
+PRESETS_DIR = Path(__file__).resolve().parent / "presets"
+"""Folder of the bundled presets."""
+
+_LIST_FIELDS = ("levels", "abstractions", "guards", "players", "scenarios")
+_ALLOWED_KEYS = (*_LIST_FIELDS, "seeds", "root_seed", "set", "description")
+
+
+@dataclass(frozen=True)
+class Preset:
+    """A validated experiment design (see the module docstring and docs/experiments.md)."""
+
+    name: str
+    source: str
+    text: str
+    levels: tuple[str, ...]
+    level_names: tuple[str, ...]
+    abstractions: tuple[str, ...]
+    guards: tuple[str, ...]
+    players: tuple[str, ...]
+    scenarios: tuple[str, ...]
+    seeds: tuple[int, ...]
+    root_seed: int = 0
+    overrides: tuple[tuple[str, Any], ...] = ()
+    description: str = ""
+    config_hash: str = ""
+    #: every config value the sweep's trials run with (defaults + the preset's [set])
+    config: Mapping[str, Any] = field(default_factory=dict)
+
+    @property
+    def n_trials(self) -> int:
+        """Number of trials of the full design."""
+        n = len(self.seeds)
+        for name in _LIST_FIELDS:
+            n *= len(getattr(self, name))
+        return n
+
+    def specs(self) -> list[TrialSpec]:
+        """Every trial of the design, in the sweep's deterministic order (seeds outermost)."""
+        return [
+            TrialSpec(level=level, abstraction=abstraction, guards=guards, player=player,
+                      scenario=scenario, seed=seed, overrides=self.overrides,
+                      root_seed=self.root_seed)
+            for seed in self.seeds
+            for level in self.levels
+            for abstraction in self.abstractions
+            for guards in self.guards
+            for player in self.players
+            for scenario in self.scenarios
+        ]
+
+    def design(self) -> dict[str, Any]:
+        """The design as JSON-able data (stored in the results' ``meta`` table)."""
+        return {
+            "levels": list(self.levels),
+            "level_names": list(self.level_names),
+            "abstractions": list(self.abstractions),
+            "guards": list(self.guards),
+            "players": list(self.players),
+            "scenarios": list(self.scenarios),
+            "seeds": list(self.seeds),
+            "root_seed": self.root_seed,
+            "set": {k: v for k, v in self.overrides},
+        }
+
+
+def bundled_preset_names() -> list[str]:
+    """Names of the presets shipped in ``headless/presets`` (sorted)."""
+    return sorted(p.stem for p in PRESETS_DIR.glob("*.toml"))
+
+
+def _preset_path(name_or_path: str) -> tuple[Path, str]:
+    """The file a ``--preset`` argument means and how to name it in messages."""
+    path = Path(name_or_path)
+    if path.is_file():
+        return path, str(name_or_path)
+    bare = "/" not in name_or_path and "\\" not in name_or_path and not name_or_path.endswith(
+        ".toml")
+    if bare:
+        bundled = PRESETS_DIR / f"{name_or_path}.toml"
+        if bundled.is_file():
+            return bundled, f"presets/{bundled.name}"
+        names = ", ".join(bundled_preset_names()) or "none"
+        raise PresetError(f"--preset {name_or_path}: no such file or bundled preset "
+                        f"(bundled presets: {names})")
+    if path.is_dir():
+        raise PresetError(f"{name_or_path}: is a directory, not a preset file")
+    raise PresetError(f"{name_or_path}: no such preset file")
+
+
+def load_preset(name_or_path: str) -> Preset:
+    """Load and fully validate a bundled preset (by name) or a preset file (by path).
+
+    Every problem raises :class:`~headless.errors.PresetError` with one line naming the file and
+    the field: unknown keys, modes, policies, abstractions or scenarios, levels that do not
+    load, empty lists or no seeds, bad ``[set]`` overrides.
+    """
+    path, src = _preset_path(name_or_path)
+    try:
+        text = path.read_text(encoding="utf-8")
+    except (OSError, UnicodeDecodeError) as error:
+        raise PresetError(f"{src}: file: cannot read ({error})") from None
+    try:
+        data = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as error:
+        raise PresetError(f"{src}: toml: not valid TOML ({error})") from None
+    return parse_preset(data, src, name=path.stem, text=text, base=path.resolve().parent)
+
+
+def _fail(src: str, field: str, problem: str) -> PresetError:
+    return PresetError(f"{src}: {field}: {' '.join(problem.splitlines())}")
+
+
+def _flatten(table: Mapping[str, Any], prefix: str = "") -> dict[str, Any]:
+    flat: dict[str, Any] = {}
+    for key, value in table.items():
+        if isinstance(value, Mapping):
+            flat.update(_flatten(value, f"{prefix}{key}."))
+        else:
+            flat[f"{prefix}{key}"] = value
+    return flat
+
+
+def _names(data: Mapping[str, Any], key: str, src: str, allowed: Sequence[str] | None) -> list[str]:
+    """A non-empty list of distinct strings, each in ``allowed`` when given."""
+    if key not in data:
+        raise _fail(src, key, "missing required key")
+    value = data[key]
+    if isinstance(value, str):
+        value = [value]
+    if not isinstance(value, list) or not all(isinstance(v, str) and v for v in value):
+        raise _fail(src, key, f"expected a list of names, got {value!r}")
+    if not value:
+        raise _fail(src, key, "empty list: the design would have no trials")
+    seen = set()
+    for v in value:
+        if allowed is not None and v not in allowed:
+            raise _fail(src, key, f"unknown value {v!r} (choose from {', '.join(allowed)})")
+        if v in seen:
+            raise _fail(src, key, f"{v!r} is listed twice")
+        seen.add(v)
+    return list(value)
+
+
+def _seeds(data: Mapping[str, Any], src: str) -> tuple[int, ...]:
+    if "seeds" not in data:
+        raise _fail(src, "seeds", "missing required key (a count, or a list of seeds)")
+    value = data["seeds"]
+    if isinstance(value, int) and not isinstance(value, bool):
+        if value <= 0:
+            raise _fail(src, "seeds", f"must be at least 1, got {value}: the design would "
+                                      "have no trials")
+        return tuple(range(value))
+    if isinstance(value, list):
+        if not value:
+            raise _fail(src, "seeds", "empty list: the design would have no trials")
+        if not all(isinstance(v, int) and not isinstance(v, bool) and v >= 0 for v in value):
+            raise _fail(src, "seeds", f"expected whole numbers >= 0, got {value!r}")
+        if len(set(value)) != len(value):
+            raise _fail(src, "seeds", "a seed is listed twice")
+        return tuple(value)
+    raise _fail(src, "seeds", f"expected a count or a list of seeds, got {value!r}")
+
+
+def _level_ref(name: str, base: Path | None) -> str:
+    """A bundled name stays a name; a path is made absolute (relative to the preset file)."""
+    bare = "/" not in name and "\\" not in name and not name.lower().endswith(".json")
+    if bare:
+        return name
+    path = Path(name).expanduser()
+    if not path.is_absolute() and base is not None:
+        path = base / path
+    return str(path.resolve())
+
+
+def parse_preset(
+    data: Mapping[str, Any],
+    src: str = "<preset>",
+    *,
+    name: str = "preset",
+    text: str = "",
+    base: Path | None = None,
+) -> Preset:
+    """Validate decoded preset data (see :func:`load_preset`); relative level paths are
+    resolved against ``base`` (the preset file's folder)."""
+    from ai import GUARD_MODES, PLAYER_POLICIES, guard_mode, player_policy
+    from game.config import Config
+    from game.errors import ConfigError
+    from game.world import SCENARIOS
+    from navmesh.errors import LevelError
+    from navmesh.graph import ABSTRACTIONS, graph_for
+    from navmesh.level import load_level
+
+    for key in data:
+        if key not in _ALLOWED_KEYS:
+            raise _fail(src, str(key), f"unknown key (allowed keys: {', '.join(_ALLOWED_KEYS)})")
+    description = data.get("description", "")
+    if not isinstance(description, str):
+        raise _fail(src, "description", "expected a string")
+    abstractions = _names(data, "abstractions", src, ABSTRACTIONS)
+    guards = _names(data, "guards", src, list(GUARD_MODES))
+    players = _names(data, "players", src, list(PLAYER_POLICIES))
+    scenarios = _names(data, "scenarios", src, SCENARIOS)
+    seeds = _seeds(data, src)
+    root_seed = data.get("root_seed", 0)
+    if isinstance(root_seed, bool) or not isinstance(root_seed, int) or root_seed < 0:
+        raise _fail(src, "root_seed", f"expected a whole number >= 0, got {root_seed!r}")
+
+    overrides_table = data.get("set", {})
+    if not isinstance(overrides_table, Mapping):
+        raise _fail(src, "set", "expected a table of config overrides (dotted keys)")
+    flat = _flatten(overrides_table)
+    try:
+        config = Config.load(flat)
+    except ConfigError as error:
+        raise _fail(src, "set", str(error)) from None
+    # The values as the config coerced them (10 -> 10.0 for a float key), so equal settings
+    # written differently give equal trial keys.
+    overrides = tuple((key, config[key]) for key in sorted(flat))
+
+    for mode in guards:
+        try:
+            registration = guard_mode(mode)
+            registration.build(config.section(registration.section))
+        except Exception as error:  # a mode that is listed but cannot be built
+            raise _fail(src, "guards", f"{mode}: cannot be loaded "
+                                       f"({type(error).__name__}: {error})") from None
+    for policy in players:
+        try:
+            policy_registration = player_policy(policy)
+            policy_registration.build(config.section(policy_registration.section))
+        except Exception as error:
+            raise _fail(src, "players", f"{policy}: cannot be loaded "
+                                        f"({type(error).__name__}: {error})") from None
+
+    level_names = _names(data, "levels", src, None)
+    refs: list[str] = []
+    names: list[str] = []
+    for level_name in level_names:
+        ref = _level_ref(level_name, base)
+        try:
+            level = load_level(ref)
+        except LevelError as error:
+            raise _fail(src, "levels", str(error)) from None
+        if level.name in names:
+            raise _fail(src, "levels", f"two levels are named {level.name!r}")
+        for abstraction in abstractions:
+            try:
+                graph_for(level, abstraction)
+            except Exception as error:
+                raise _fail(src, "abstractions", f"{abstraction}: cannot build the graph of "
+                            f"level {level.name!r} ({type(error).__name__}: {error})") from None
+        refs.append(ref)
+        names.append(level.name)
+
+    return Preset(
+        name=name, source=src, text=text, levels=tuple(refs), level_names=tuple(names),
+        abstractions=tuple(abstractions), guards=tuple(guards), players=tuple(players),
+        scenarios=tuple(scenarios), seeds=seeds, root_seed=root_seed, overrides=overrides,
+        description=description, config_hash=config.hash(), config=config.as_dict(),
+    )
+
+
+def bundled_presets() -> list[tuple[str, str]]:
+    """``(name, description)`` of every bundled preset, sorted by name (for ``stealth presets``).
+
+    Only the description is read: listing does not validate or load the levels.
+    """
+    listed = []
+    for name in bundled_preset_names():
+        try:
+            data = tomllib.loads((PRESETS_DIR / f"{name}.toml").read_text(encoding="utf-8"))
+        except (OSError, UnicodeDecodeError, tomllib.TOMLDecodeError):
+            data = {}
+        description = data.get("description", "")
+        listed.append((name, description if isinstance(description, str) else ""))
+    return listed
