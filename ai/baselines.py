@@ -243,7 +243,7 @@ class FSMGuards(ScriptedGuards):
     config_type = FSMParams
 
     def _patrol_target(self, i: int, node: int) -> int:
-        allowed = np.isfinite(self.graph.dist[node])
+        allowed = self.graph.reachable_from(node)
         allowed[node] = False
         allowed[self._taken_targets(i)] = False
         options = np.flatnonzero(allowed)
@@ -277,7 +277,7 @@ class StalenessGuards(ScriptedGuards):
         self.staleness[node] = 0.0
 
     def _patrol_target(self, i: int, node: int) -> int:
-        values = np.where(np.isfinite(self.graph.dist[node]), self.staleness, -np.inf)
+        values = np.where(self.graph.reachable_from(node), self.staleness, -np.inf)
         values[node] = -np.inf
         values[self._taken_targets(i)] = -np.inf
         best = values.max()

@@ -1,9 +1,9 @@
 """The composite potential field of the guard team (paper §Methods; SPEC §3).
 
-Everything that depends only on the graph and the parameters — ``γ_I^hops``, ``γ_C^hops``,
-the row-normalised kernel matrix, the connectivity field and the candidate sets — is
-computed once per :class:`~navmesh.graph.NodeGraph` and cached, because thousands of trials
-reuse one graph. A tick and a decision are then a handful of numpy vector operations and one
+Everything that depends only on the graph and the parameters — the spreads ``γ_I^d`` and
+``γ_C^d`` per source node, the row-normalised kernel matrix, the connectivity field and the
+candidate sets — is computed once per :class:`~navmesh.graph.NodeGraph` and cached, because
+thousands of trials reuse one graph; nothing is n × n, so large levels fit. A tick and a decision are then a handful of numpy vector operations and one
 sparse matrix-vector product; there is no per-node Python loop (SPEC §3.8).
 
 State arrays are never modified in place: every tick makes new arrays and marks them
@@ -24,13 +24,12 @@ from __future__ import annotations
 
 import weakref
 from collections.abc import Sequence
-from dataclasses import dataclass
 from typing import NamedTuple
 
 import numpy as np
 from scipy import sparse
 
-from navmesh.graph import UNREACHABLE_HOPS, NodeGraph
+from navmesh.graph import UNREACHABLE_HOPS, NodeGraph, RowCache, falloff_depth, hop_ball_pairs
 
 from .params import PFParams
 from .view import WorldView
@@ -38,24 +37,75 @@ from .view import WorldView
 # ---------------------------------------------------------------------------- precomputation
 
 
-@dataclass(frozen=True, eq=False)
-class FieldMatrices:
-    """What never changes for one graph and one parameter set; shared by every trial on it."""
+#: Spreads ``γ^d`` are cut to 0 where ``γ^d`` drops below this (far below the 1e-9 tie
+#: threshold of every argmin); on the bundled levels no spread reaches that depth.
+SPREAD_TOLERANCE = 1e-12
 
-    #: (n, n) ``γ_I ** hops``: row p is the information spread of a sighting at p (0 if unreachable)
-    info_spread: np.ndarray
-    #: (n, n) ``γ_C ** hops``: row g is one guard's confidence deposit from node g
-    conf_spread: np.ndarray
-    #: (n, n) CSR, ``K[x, y] = λ^d(x,y) / Σ_{d(x,z) ≤ δ} λ^d(x,z)`` for ``d(x, y) ≤ δ``, else 0
-    kernel: sparse.csr_matrix
-    #: (n, n) row g = the kernel-smoothed deposit ``Kmat @ γ_C^d(g, ·)`` of a guard standing at g
-    presence: np.ndarray
-    #: (n,) ``κ − degree`` with κ the graph's maximum degree
-    connectivity: np.ndarray
-    #: per node, the nodes a guard standing there may choose (SPEC §3.5)
-    candidates: tuple[np.ndarray, ...]
-    #: partition candidate horizon in world units (``r_edge_factor × mean edge length``)
-    r_edge: float
+#: Bytes of per-source spread rows and kernel blocks one :class:`FieldMatrices` keeps.
+SPREAD_CACHE_BYTES = 128 * 2**20
+
+
+class FieldMatrices:
+    """What never changes for one graph and one parameter set; shared by every trial on it.
+
+    Nothing here is n × n: the spreads ``γ^d(s, ·)`` are computed per source node by a BFS
+    cut at :data:`SPREAD_TOLERANCE` and cached (guards and sightings sit on few nodes), the
+    kernel is a sparse radius-δ matrix and the candidate sets are found per node on first use.
+    """
+
+    def __init__(self, graph: NodeGraph, params: PFParams) -> None:
+        self.graph = graph
+        self.gamma_I, self.gamma_C = params.gamma_I, params.gamma_C
+        self.depth_I = falloff_depth(params.gamma_I, SPREAD_TOLERANCE)
+        self.depth_C = falloff_depth(params.gamma_C, SPREAD_TOLERANCE)
+        #: (n, n) CSR, ``K[x, y] = λ^d(x,y) / Σ_{d(x,z) ≤ δ} λ^d(x,z)`` for ``d(x, y) ≤ δ``, else 0
+        self.kernel = kernel_matrix(graph, params.kernel_lambda, params.kernel_radius)
+        degree = np.asarray(graph.degree, dtype=np.float64)
+        #: (n,) ``κ − degree`` with κ the graph's maximum degree
+        self.connectivity = _read_only(graph.max_degree - degree)
+        #: partition candidate horizon in world units (``r_edge_factor × mean edge length``)
+        self.r_edge = params.r_edge_factor * graph.mean_edge_length
+        #: per node, the nodes a guard standing there may choose (SPEC §3.5)
+        self.candidates = CandidateSets(graph, params.r_edge_factor)
+        self._rows = RowCache(SPREAD_CACHE_BYTES)
+
+    def _spread(self, which: str, node: int) -> np.ndarray:
+        gamma, depth = (self.gamma_I, self.depth_I) if which == "I" else (self.gamma_C, self.depth_C)
+
+        def make() -> tuple[np.ndarray]:
+            hops = self.graph.hops_from(node, max_hops=depth)
+            inside = np.flatnonzero(hops < UNREACHABLE_HOPS)
+            row = np.zeros(self.graph.n)
+            row[inside] = gamma ** hops[inside].astype(np.float64)
+            return (row,)
+
+        return self._rows.get((which, node), make)[0]
+
+    def info_spread(self, node: int) -> np.ndarray:
+        """(n,) ``γ_I ** d(node, ·)``: the information spread of a sighting at ``node`` (read-only)."""
+        return self._spread("I", int(node))
+
+    def conf_spread(self, node: int) -> np.ndarray:
+        """(n,) ``γ_C ** d(node, ·)``: one guard's confidence deposit from ``node`` (read-only)."""
+        return self._spread("C", int(node))
+
+    def deposit(self, nodes: Sequence[int] | np.ndarray) -> np.ndarray:
+        """(n,) ``Σ_g γ_C ** d(g, ·)`` over ``nodes``, summed in their order (zeros if none)."""
+        nodes = np.asarray(nodes, dtype=np.intp)
+        if not len(nodes):
+            return np.zeros(self.graph.n)
+        total = self.conf_spread(int(nodes[0])).copy()
+        for g in nodes[1:]:
+            total += self.conf_spread(int(g))
+        return total
+
+    def presence(self, teammates: Sequence[int] | np.ndarray, node: int) -> np.ndarray:
+        """(c,) ``Σ_t (Kmat @ γ_C^d(t, ·))`` at the candidates of ``node``, over ``teammates``."""
+        candidates = self.candidates[node]
+        block = self._rows.get(("K", int(node)), lambda: (self.kernel[candidates],))[0]
+        spreads = np.stack([self.conf_spread(int(t)) for t in teammates])
+        smoothed = np.asarray(block @ spreads.T)  # (c, t): one kernel row per candidate
+        return np.ascontiguousarray(smoothed.T).sum(axis=0)
 
 
 _MATRIX_CACHE: weakref.WeakKeyDictionary[NodeGraph, dict[tuple[float, ...], FieldMatrices]] = (
@@ -78,64 +128,73 @@ def field_matrices(graph: NodeGraph, params: PFParams) -> FieldMatrices:
     per_graph = _MATRIX_CACHE.setdefault(graph, {})
     matrices = per_graph.get(key)
     if matrices is None:
-        hops = graph.hops.astype(np.float64)
-        reachable = graph.hops < UNREACHABLE_HOPS
-        info_spread = np.where(reachable, params.gamma_I**hops, 0.0)
-        conf_spread = np.where(reachable, params.gamma_C**hops, 0.0)
-        degree = np.asarray(graph.degree, dtype=np.float64)
-        connectivity = graph.max_degree - degree
-        r_edge = params.r_edge_factor * graph.mean_edge_length
-        kernel = kernel_matrix(graph.hops, params.kernel_lambda, params.kernel_radius)
-        presence = np.ascontiguousarray(np.asarray(kernel @ conf_spread).T)
-        matrices = FieldMatrices(
-            info_spread=_read_only(info_spread),
-            conf_spread=_read_only(conf_spread),
-            kernel=kernel,
-            presence=_read_only(presence),
-            connectivity=_read_only(connectivity),
-            candidates=candidate_sets(graph, params.r_edge_factor),
-            r_edge=r_edge,
-        )
+        matrices = FieldMatrices(graph, params)
         per_graph[key] = matrices
     return matrices
 
 
-def kernel_matrix(hops: np.ndarray, lam: float, radius: int) -> sparse.csr_matrix:
+def kernel_matrix(graph: NodeGraph, lam: float, radius: int) -> sparse.csr_matrix:
     """Row-normalised smoothing kernel ``λ^d / Σ λ^d`` over the hop ball of ``radius``."""
-    rows, cols = np.nonzero(hops <= radius)
-    weights = lam ** hops[rows, cols].astype(np.float64)
-    totals = np.bincount(rows, weights=weights, minlength=len(hops))
-    n = len(hops)
+    rows, cols, hops = hop_ball_pairs(graph, radius)
+    weights = lam ** hops.astype(np.float64)
+    n = graph.n
+    totals = np.bincount(rows, weights=weights, minlength=n)
     return sparse.csr_matrix((weights / totals[rows], (rows, cols)), shape=(n, n))
 
 
-def candidate_sets(graph: NodeGraph, r_edge_factor: float) -> tuple[np.ndarray, ...]:
-    """Per node, the nodes a guard there may choose next (SPEC §3.5).
+class CandidateSets(Sequence[np.ndarray]):
+    """Per node, the nodes a guard there may choose next (SPEC §3.5), found on first use.
 
     Grid: the 4-neighbours. Partition: the frontier of a metric search (Dijkstra) from the
     node at ``R = r_edge_factor × mean edge length`` — every node v with ``dist(s, v) ≥ R``
     reached over a shortest-path edge (u, v) whose start is still inside, ``dist(s, u) < R``;
     the adjacent nodes when that frontier is empty (the whole reachable graph lies within R).
+    The search stops just past R (the frontier is at most one edge beyond it).
     """
-    neighbours = tuple(np.asarray(nb, dtype=np.intp) for nb in graph.neighbors)
-    if graph.kind == "grid":
-        return neighbours
-    r_edge = r_edge_factor * graph.mean_edge_length
-    if graph.n == 0 or r_edge <= 0:
-        return neighbours
-    coo = graph.adjacency.tocoo()
-    u, v, w = coo.row, coo.col, coo.data
-    result: list[np.ndarray] = []
-    chunk = 256
-    for start in range(0, graph.n, chunk):
-        du = graph.dist[start : start + chunk][:, u]
-        dv = graph.dist[start : start + chunk][:, v]
+
+    def __init__(self, graph: NodeGraph, r_edge_factor: float) -> None:
+        self.graph = graph
+        self.r_edge = r_edge_factor * graph.mean_edge_length
+        self._found: dict[int, np.ndarray] = {}
+
+    def __len__(self) -> int:
+        return self.graph.n
+
+    def __getitem__(self, node):  # type: ignore[no-untyped-def,override]
+        s = int(node)
+        found = self._found.get(s)
+        if found is None:
+            found = self._frontier(s)
+            found.flags.writeable = False
+            self._found[s] = found
+        return found
+
+    def _frontier(self, s: int) -> np.ndarray:
+        graph, r_edge = self.graph, self.r_edge
+        neighbours = np.asarray(graph.neighbors[s], dtype=np.intp)
+        if graph.kind == "grid" or r_edge <= 0:
+            return neighbours
+        limit = (r_edge + graph.max_edge_length) * (1 + 1e-8) + 1e-8
+        dist = graph.dist_from(s, limit=limit)
+        adjacency = graph.adjacency
+        inside = np.flatnonzero(dist < r_edge)
+        lo, hi = adjacency.indptr[inside], adjacency.indptr[inside + 1]
+        counts = hi - lo
+        u = np.repeat(inside, counts)
+        edges = np.repeat(lo - np.cumsum(counts) + counts, counts) + np.arange(counts.sum())
+        v, w = adjacency.indices[edges], adjacency.data[edges]
+        du, dv = dist[u], dist[v]
         tol = 1e-9 * (1.0 + np.abs(dv))
-        frontier = (du < r_edge) & (dv >= r_edge) & (np.abs(du + w - dv) <= tol)
-        for row, s in zip(frontier, range(start, min(start + chunk, graph.n)), strict=True):
-            found = np.unique(v[row]).astype(np.intp)
-            result.append(found if len(found) else neighbours[s])
-    return tuple(result)
+        with np.errstate(invalid="ignore"):
+            frontier = (dv >= r_edge) & (np.abs(du + w - dv) <= tol)
+        found = np.unique(v[frontier]).astype(np.intp)
+        return found if len(found) else neighbours
+
+
+def candidate_sets(graph: NodeGraph, r_edge_factor: float) -> tuple[np.ndarray, ...]:
+    """Every node's candidate set (:class:`CandidateSets`), e.g. for tests and plots."""
+    sets = CandidateSets(graph, r_edge_factor)
+    return tuple(sets[s] for s in range(graph.n))
 
 
 def _read_only(array: np.ndarray) -> np.ndarray:
@@ -309,7 +368,7 @@ class CompositeField:
             raise ValueError(f"dt must be >= 0, got {dt}")
         p, m = self.params, self.matrices
         if sighting_node is not None:
-            information = -p.I0 * m.info_spread[sighting_node]
+            information = -p.I0 * m.info_spread(sighting_node)
             self._set_w_I(p.w_I_max)
         else:
             information = self._information * (p.rho**dt)
@@ -319,7 +378,7 @@ class CompositeField:
         confidence = self._confidence * self._decay_power(dt)
         guards = np.asarray(guard_nodes, dtype=np.intp)
         if len(guards):
-            confidence = confidence + p.C0 * m.conf_spread[guards].sum(axis=0)
+            confidence = confidence + p.C0 * m.deposit(guards)
         self._information = _read_only(information)
         self._confidence = _read_only(confidence)
         self.ticks += 1
@@ -380,8 +439,7 @@ class CompositeField:
         scores = self.kernel()[candidates]
         scale = self.w_C * self.params.teammate_presence * self.params.C0
         if len(teammates) and scale:
-            presence = self.matrices.presence[np.asarray(teammates, dtype=np.intp)]
-            scores = scores + scale * presence[:, candidates].sum(axis=0)
+            scores = scores + scale * self.matrices.presence(teammates, node)
         revisit = self.revisit_term(candidates, recent)
         if revisit is not None:
             scores = scores + revisit
@@ -414,7 +472,7 @@ class CompositeField:
         """C_live (n,): teammates' deposit at their current nodes × teammate_presence."""
         live = np.zeros(self.graph.n)
         if len(teammates):
-            live = self.matrices.conf_spread[np.asarray(teammates, dtype=np.intp)].sum(axis=0)
+            live = self.matrices.deposit(teammates)
         return self.params.teammate_presence * self.params.C0 * live
 
     def fields(self) -> dict[str, np.ndarray]:
@@ -432,6 +490,7 @@ class CompositeField:
 
 __all__ = [
     "CompositeField",
+    "CandidateSets",
     "Choice",
     "FieldMatrices",
     "field_matrices",

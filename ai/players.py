@@ -42,7 +42,7 @@ class EvadePlayer(PlayerPolicy):
             guards = guards[np.asarray(view.guard_active, dtype=bool)]
         if len(guards) == 0:
             return node
-        safety = self.graph.dist[np.ix_(options, guards)].min(axis=1)
+        safety = self.graph.dist_from(options)[:, guards].min(axis=1)
         best = np.flatnonzero(safety >= safety.max() - 1e-9)
         return int(options[best[self.rng.integers(len(best))]])
 
@@ -120,13 +120,15 @@ class MaxMinPlayer(PlayerPolicy):
             else 0.0
         )
         self.closing = step * np.arange(1, c.maxmin_depth + 1)
+        self.reach = c.maxmin_depth * graph.max_edge_length
 
     def decide(self, view: WorldView) -> int:
         node = int(view.player_node)
         guards = active_guard_nodes(view)
         if len(guards) == 0:
             return node
-        nearest = self.graph.dist[guards].min(axis=0)  # (n,) distance to the closest guard
+        # (n,) distance to the closest guard, promised on the nodes the sequences can reach
+        nearest = self.graph.nearest_dist(guards, around=node, reach=self.reach)
         paths = self.sequences.from_node(node)
         along = nearest[paths] - self.closing  # (m, depth)
         score = along.min(axis=1)
@@ -176,9 +178,9 @@ class SafetyGraphPlayer(PlayerPolicy):
     def safety(self, player: int, guards: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """(S, T_g) per node for the player at ``player`` and guards at ``guards``."""
         c = self.config
-        guard_time = self.graph.dist[guards].min(axis=0) / c.guard_speed
+        guard_time = self.graph.nearest_dist(guards) / c.guard_speed
         with np.errstate(invalid="ignore"):  # inf − inf on a disconnected graph: NaN = unreachable
-            return guard_time - self.graph.dist[player] / c.player_speed, guard_time
+            return guard_time - self.graph.dist_from(player) / c.player_speed, guard_time
 
     def decide(self, view: WorldView) -> int:
         node = int(view.player_node)
@@ -195,7 +197,7 @@ class SafetyGraphPlayer(PlayerPolicy):
     def choose_goal(self, node: int, safety: np.ndarray, guard_time: np.ndarray) -> int:
         """The reachable node with the largest T_g among those with S ≥ margin (see the class)."""
         c = self.config
-        reachable = np.isfinite(self.graph.dist[node])
+        reachable = self.graph.reachable_from(node)
         safe = reachable & (safety >= c.safety_margin)
         if safe.any():
             primary, secondary = np.where(safe, guard_time, -np.inf), safety

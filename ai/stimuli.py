@@ -16,7 +16,7 @@ a mode opts in with ``hears_stimuli()``) that a :class:`StimulusSet` drives once
 A **zone** (:class:`Zone`) is the static counterpart: it says what it does to the
 confidence decay of its cells and to the guards' view range when the player stands in it.
 
-Distances are hop distances on the node graph (``graph.hops``), as everywhere in the fields.
+Distances are hop distances on the node graph (``graph.hops_from``), as everywhere in the fields.
 
 >>> import numpy as np
 >>> from navmesh.graph import NodeGraph
@@ -139,16 +139,17 @@ class FieldContext:
     def n(self) -> int:
         return self.graph.n
 
-    def hops_from(self, node: int) -> np.ndarray:
-        """Hop distance (BFS) from ``node`` to every node (a huge number where unreachable)."""
-        return self.graph.hops[int(node)]
+    def hops_from(self, node: int, max_hops: int | None = None) -> np.ndarray:
+        """Hop distance (BFS) from ``node`` to every node (a huge number where unreachable or,
+        with ``max_hops``, farther: a large graph then only searches that far)."""
+        return self.graph.hops_from(int(node), max_hops)
 
     def falloff(self, node: int, base: float, max_hops: int | None = None) -> np.ndarray:
         """``base ** d(node, ·)`` for every node; 0 where unreachable or beyond ``max_hops``.
 
         Multiply by ``−amplitude`` for an attractive layer, e.g. ``−3 · ctx.falloff(p, 0.6, 5)``.
         """
-        hops = self.hops_from(node)
+        hops = self.hops_from(node, max_hops)
         limit = UNREACHABLE_HOPS if max_hops is None else min(int(max_hops) + 1, UNREACHABLE_HOPS)
         inside = hops < limit
         return np.where(inside, float(base) ** np.where(inside, hops, 0).astype(np.float64), 0.0)
@@ -240,7 +241,7 @@ class GuardPresence:
         if view.guard_active is not None:
             guards = guards[np.asarray(view.guard_active, dtype=bool)]
         near = bool(len(guards)) and bool(
-            (view.graph.hops[self.node, guards] <= self.radius).any()
+            (view.graph.hops_from(self.node, self.radius)[guards] <= self.radius).any()
         )
         if near:
             self.seconds += dt

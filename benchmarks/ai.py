@@ -106,7 +106,7 @@ def graphs(levels: list[str] | None) -> list[tuple[str, NodeGraph]]:
     occupancy = rng.random((26, 39)) > 0.2
     synthetic = NodeGraph.from_grid(occupancy, 1.0)
     # keep the component of the first node so every pair is connected, like a valid level
-    keep = np.isfinite(synthetic.dist[0])
+    keep = synthetic.reachable_from(0)
     cells = synthetic.node_cell[~keep]
     occupancy[cells[:, 0], cells[:, 1]] = False
     found.append(("synthetic 26x39 grid", NodeGraph.from_grid(occupancy, 1.0)))

@@ -57,7 +57,7 @@ def _direction_table(graph: NodeGraph) -> np.ndarray:
         if graph.kind == "grid":
             options = np.asarray(graph.neighbors[node])
         else:
-            hops = graph.hops[node]
+            hops = graph.hops_from(node, max_hops=2)
             options = np.flatnonzero((hops >= 1) & (hops <= 2))
         if not len(options):
             continue

@@ -63,7 +63,7 @@ class Counters:
         key = (player_node, *guard_nodes)
         if key != self._dist_key:
             self._dist_key = key
-            self._dist_now = (float(graph.dist[guard_nodes, player_node].min())
+            self._dist_now = (graph.nearest_dist_to(guard_nodes, player_node)
                               if guard_nodes else None)
         if self._dist_now is not None:
             self.dist_sum += self._dist_now

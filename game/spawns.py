@@ -35,7 +35,7 @@ def start_node(graph: NodeGraph, guards: Sequence[Agent], senses: Senses, view_r
     active = [g for g in guards if g.active]
     if not active:
         return int(rng.integers(graph.n))
-    score = graph.dist[np.array([g.node for g in active])].min(axis=0)
+    score = graph.nearest_dist(np.array([g.node for g in active]))
     visible = np.zeros(graph.n, dtype=bool)
     for g in active:
         visible |= senses.visible_points(g.pos, g.heading, graph.positions, view_range)

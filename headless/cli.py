@@ -71,8 +71,13 @@ def level_stats(level: Any) -> dict[str, Any]:
 def cmd_levels(args: argparse.Namespace) -> int:
     from navmesh.level import bundled_level_names, load_level
 
+    from navmesh.graph import check_fits
+
     names = args.level or bundled_level_names()
-    rows = [level_stats(load_level(name)) for name in names]
+    levels = [load_level(name) for name in names]
+    for name, level in zip(names, levels, strict=True):
+        check_fits(level, str(name))  # refuse before building what cannot fit
+    rows = [level_stats(level) for level in levels]
     if args.json:
         _emit_json(rows)
         return 0
@@ -92,12 +97,14 @@ def cmd_levels(args: argparse.Namespace) -> int:
 
 def cmd_validate(args: argparse.Namespace) -> int:
     from navmesh.errors import LevelError
+    from navmesh.graph import check_fits
     from navmesh.level import load_level
 
     failed = 0
     for name in args.level:
         try:
             level = load_level(name)
+            check_fits(level, str(name))
         except LevelError as error:
             print(f"stealth: error: {error}", file=sys.stderr)
             failed += 1

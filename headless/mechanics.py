@@ -117,7 +117,7 @@ def decoy(level: str, abstraction: str, seed: int) -> Measures:
     for on in (True, False):
         world = make_world(level, abstraction, seed, BLIND)
         if target < 0:
-            far = world.graph.hops[active_guard_nodes(world)].min(axis=0) >= 8
+            far = world.graph.hops_from(active_guard_nodes(world)).min(axis=0) >= 8
             options = np.flatnonzero(far) if far.any() else np.arange(world.graph.n)
             target = int(options[world.stimuli.ctx.rng.integers(len(options))])
         if on:
@@ -169,7 +169,7 @@ def corpse(level: str, abstraction: str, seed: int) -> Measures:
             nonlocal removal
             if w.step_index % w.steps_per_tick:
                 return
-            track.append(float(w.graph.hops[active_guard_nodes(w), body].min()))
+            track.append(float(w.graph.hops_between(active_guard_nodes(w), body).min()))
             present = any(s.name == "corpse" for s in w.stimuli.active)
             if on and present:
                 found[0] = True
@@ -258,7 +258,7 @@ def _draw(level: str, abstraction: str, seed: int, d: int, sound: str) -> float:
     none): 1.0 if a guard steps onto its source within d/2 + 3 s (the walk plus 3 s)."""
     world = make_world(level, abstraction, seed, {**BLIND, "stimuli.raining": sound == "rain"})
     run_until(world, 1.0)
-    nearest = world.graph.hops[active_guard_nodes(world)].min(axis=0)
+    nearest = world.graph.hops_from(active_guard_nodes(world)).min(axis=0)
     options = np.flatnonzero(nearest == d)
     if not len(options):
         return math.nan

@@ -1,20 +1,30 @@
 """The node graph both abstractions share (SPEC §2).
 
 A grid level and a navmesh partition both become a :class:`NodeGraph`: node positions in
-world coordinates, adjacency, edge lengths, the BFS hop-distance matrix and the metric
-shortest-path matrix. The AI works on this type only and never asks which abstraction it
-is running on.
+world coordinates, adjacency (CSR) and edge lengths, with hop (BFS) and metric (Dijkstra)
+distance queries. The AI works on this type only and never asks which abstraction it is
+running on.
+
+Distances are computed on demand, so memory grows with the level rather than its square:
+a graph of at most :data:`DENSE_MAX_NODES` nodes (every bundled level) computes its dense
+all-pairs matrices once, because that is cheapest there; a larger one answers each query
+with a search from the source (:func:`scipy.sparse.csgraph.dijkstra`) and keeps the last
+rows in a cache bounded in bytes (:data:`ROW_CACHE_BYTES`). Both run the same per-source
+search on the same CSR matrix, so every answer is bit-identical whichever path a graph
+takes (tests/test_graph_queries.py checks it).
 """
 
 from __future__ import annotations
 
+from collections import OrderedDict
+from collections.abc import Callable, Hashable, Iterator, Sequence
 from dataclasses import dataclass, field
 from functools import lru_cache
 from typing import TYPE_CHECKING, Literal
 
 import numpy as np
 from scipy.sparse import csr_matrix
-from scipy.sparse.csgraph import shortest_path
+from scipy.sparse.csgraph import connected_components, dijkstra, shortest_path
 
 if TYPE_CHECKING:
     from .level import Level
@@ -23,55 +33,167 @@ if TYPE_CHECKING:
 Abstraction = Literal["grid", "partition"]
 ABSTRACTIONS: tuple[str, ...] = ("grid", "partition")
 
-#: Hop distance used for node pairs that are not connected (never happens on a valid level).
+#: Hop distance used for node pairs that are not connected (or beyond a search's max_hops).
 UNREACHABLE_HOPS = np.iinfo(np.int32).max // 4
+
+#: Graphs with at most this many nodes keep dense all-pairs matrices (20 bytes × n²:
+#: 84 MB at the limit); larger ones search per source. Results are the same either way.
+DENSE_MAX_NODES = 2048
+
+#: Bytes of per-source distance rows a sparse graph keeps (least recently used go first).
+ROW_CACHE_BYTES = 256 * 2**20
+
+
+def falloff_depth(base: float, tolerance: float = 1e-12) -> int | None:
+    """The largest hop count d with ``base ** d ≥ tolerance`` (None when base ≥ 1: no cut-off).
+
+    A field that spreads ``base ** d`` from a source is exactly 0 beyond this depth: the
+    dropped terms are below ``tolerance`` (1e-12, far below the 1e-9 tie threshold of every
+    argmin), so a search may stop there.
+
+    >>> falloff_depth(0.8), falloff_depth(0.9), falloff_depth(1.0)
+    (123, 262, None)
+    """
+    if base >= 1.0:
+        return None
+    if base <= 0.0:
+        return 0
+    depth = int(np.floor(np.log(tolerance) / np.log(base)))
+    while base ** (depth + 1) >= tolerance:  # guard the floor against rounding either way
+        depth += 1
+    while depth > 0 and base**depth < tolerance:
+        depth -= 1
+    return depth
+
+
+class Neighbours(Sequence[np.ndarray]):
+    """Per-node neighbour lists backed by two CSR arrays (no Python object per node)."""
+
+    def __init__(self, indptr: np.ndarray, indices: np.ndarray) -> None:
+        self.indptr, self.indices = indptr, indices
+        self.indices.flags.writeable = False
+
+    def __len__(self) -> int:
+        return len(self.indptr) - 1
+
+    def __getitem__(self, node):  # type: ignore[no-untyped-def,override]
+        if isinstance(node, slice):
+            return [self[i] for i in range(*node.indices(len(self)))]
+        node = int(node)
+        if node < 0:
+            node += len(self)
+        return self.indices[self.indptr[node] : self.indptr[node + 1]]
+
+    def __iter__(self) -> Iterator[np.ndarray]:
+        for node in range(len(self)):
+            yield self.indices[self.indptr[node] : self.indptr[node + 1]]
+
+    @classmethod
+    def from_lists(cls, lists: Sequence[Sequence[int]]) -> Neighbours:
+        """Pack per-node lists (kept in their given order)."""
+        if isinstance(lists, Neighbours):
+            return lists
+        lengths = np.fromiter((len(nb) for nb in lists), dtype=np.int64, count=len(lists))
+        indptr = np.zeros(len(lists) + 1, dtype=np.int64)
+        np.cumsum(lengths, out=indptr[1:])
+        parts = [np.asarray(nb, dtype=np.int64) for nb in lists]
+        indices = np.concatenate(parts) if parts else np.zeros(0, dtype=np.int64)
+        return cls(indptr, indices.astype(np.int64, copy=False))
+
+
+class RowCache:
+    """Least-recently-used per-key arrays, bounded by their total bytes."""
+
+    def __init__(self, max_bytes: int) -> None:
+        self.max_bytes, self.bytes = max_bytes, 0
+        self._rows: OrderedDict[Hashable, tuple[np.ndarray, ...]] = OrderedDict()
+
+    def get(self, key: Hashable, make: Callable[[], tuple[np.ndarray, ...]]) -> tuple[np.ndarray, ...]:
+        rows = self._rows.get(key)
+        if rows is not None:
+            self._rows.move_to_end(key)
+            return rows
+        rows = make()
+        for row in rows:
+            if isinstance(row, np.ndarray):
+                row.flags.writeable = False
+        size = sum(_nbytes(row) for row in rows)
+        while self._rows and self.bytes + size > self.max_bytes:
+            _, old = self._rows.popitem(last=False)
+            self.bytes -= sum(_nbytes(row) for row in old)
+        if size <= self.max_bytes:
+            self._rows[key] = rows
+            self.bytes += size
+        return rows
+
+
+def _nbytes(value: object) -> int:
+    """Bytes of an array or of a sparse matrix's three arrays."""
+    if isinstance(value, np.ndarray):
+        return value.nbytes
+    return sum(getattr(value, part).nbytes for part in ("data", "indices", "indptr"))
+
+
+def _as_hops(found: np.ndarray) -> np.ndarray:
+    """A float hop array from a search as int32, :data:`UNREACHABLE_HOPS` where infinite."""
+    out = np.full(found.shape, UNREACHABLE_HOPS, dtype=np.int32)
+    finite = np.isfinite(found)
+    out[finite] = found[finite]
+    return out
 
 
 @dataclass(eq=False)
 class NodeGraph:
-    """Nodes, adjacency and all-pairs distances of one level in one abstraction.
+    """Nodes, adjacency and distance queries of one level in one abstraction.
 
-    Build it with :meth:`from_grid` or :meth:`from_mesh`; the matrices are computed once.
+    Build it with :meth:`from_grid` or :meth:`from_mesh`. ``dense`` chooses the storage of
+    distances (None: dense up to :data:`DENSE_MAX_NODES` nodes); it never changes a result.
 
     >>> import numpy as np
     >>> g = NodeGraph.from_grid(np.array([[True, True, True]]), 1.0)
-    >>> g.hops[0].tolist(), g.positions[2].tolist()
-    ([0, 1, 2], [2.5, 0.5])
+    >>> g.hops_from(0).tolist(), g.dist_between(0, 2), g.positions[2].tolist()
+    ([0, 1, 2], 2.0, [2.5, 0.5])
     """
 
     kind: str
     positions: np.ndarray
-    neighbors: tuple[np.ndarray, ...]
+    neighbors: Sequence[np.ndarray]
     mesh: NavMesh | None = None
     cell_size: float = 1.0
     #: grid only: (rows, cols) array mapping a cell to its node index, -1 for blocked cells
     cell_node: np.ndarray | None = None
     #: grid only: (n, 2) array of (row, col) per node
     node_cell: np.ndarray | None = None
+    #: dense all-pairs matrices (True), per-source searches (False) or by size (None)
+    dense: bool | None = None
     adjacency: csr_matrix = field(init=False, repr=False)
-    hops: np.ndarray = field(init=False, repr=False)
-    dist: np.ndarray = field(init=False, repr=False)
-    _pred: np.ndarray = field(init=False, repr=False)
 
     def __post_init__(self) -> None:
+        self.neighbors = Neighbours.from_lists(self.neighbors)
         n = len(self.positions)
-        rows = np.repeat(np.arange(n), [len(nb) for nb in self.neighbors])
-        cols = np.concatenate(self.neighbors) if n else np.zeros(0, dtype=np.int64)
+        nb = self.neighbors
+        rows = np.repeat(np.arange(n), np.diff(nb.indptr))
+        cols = nb.indices
         lengths = np.linalg.norm(self.positions[rows] - self.positions[cols], axis=1)
         self.adjacency = csr_matrix((lengths, (rows, cols)), shape=(n, n))
-        hop_matrix = shortest_path(self.adjacency, method="D", unweighted=True)
-        hop_matrix[~np.isfinite(hop_matrix)] = UNREACHABLE_HOPS
-        self.hops = hop_matrix.astype(np.int32)
-        self.dist, self._pred = shortest_path(
-            self.adjacency, method="D", directed=False, return_predecessors=True
-        )
+        if self.dense is None:
+            self.dense = n <= DENSE_MAX_NODES
+        self._rows = RowCache(ROW_CACHE_BYTES)
+        self._labels: np.ndarray | None = None
+        self._last_search: tuple[tuple[int, ...], float, np.ndarray] | None = None
+        self._last_bound: tuple[tuple[tuple[int, ...], int], float] | None = None
+        if self.dense:
+            hop_matrix = shortest_path(self.adjacency, method="D", unweighted=True)
+            self._hops = _as_hops(hop_matrix)
+            self._dist, self._pred = shortest_path(
+                self.adjacency, method="D", directed=False, return_predecessors=True
+            )
 
     # ------------------------------------------------------------------ construction
     @classmethod
-    def from_grid(cls, occupancy: np.ndarray, cell_size: float) -> NodeGraph:
+    def from_grid(cls, occupancy: np.ndarray, cell_size: float, dense: bool | None = None) -> NodeGraph:
         """Walkable cells as nodes (row-major order), 4-neighbourhood, cell-centre positions."""
         occupancy = np.asarray(occupancy, dtype=bool)
-        rows, cols = occupancy.shape
         node_cell = np.argwhere(occupancy)
         cell_node = np.full(occupancy.shape, -1, dtype=np.int64)
         cell_node[node_cell[:, 0], node_cell[:, 1]] = np.arange(len(node_cell))
@@ -81,26 +203,26 @@ class NodeGraph:
         around = np.stack(
             [padded[r - 1, c], padded[r + 1, c], padded[r, c - 1], padded[r, c + 1]], axis=1
         )
-        neighbors = tuple(row[row >= 0] for row in around)
         positions = (node_cell[:, ::-1] + 0.5) * cell_size
         return cls(
             kind="grid",
             positions=positions.astype(np.float64),
-            neighbors=neighbors,
+            neighbors=_pack(around),
             cell_size=cell_size,
             cell_node=cell_node,
             node_cell=node_cell,
+            dense=dense,
         )
 
     @classmethod
-    def from_mesh(cls, mesh: NavMesh) -> NodeGraph:
+    def from_mesh(cls, mesh: NavMesh, dense: bool | None = None) -> NodeGraph:
         """Triangle centroids as nodes; triangles sharing an edge are neighbours."""
-        neighbors = tuple(np.sort(row[row >= 0]) for row in np.asarray(mesh.neighbors))
         return cls(
             kind="partition",
             positions=np.asarray(mesh.centroids, dtype=np.float64),
-            neighbors=neighbors,
+            neighbors=_pack(np.sort(np.asarray(mesh.neighbors), axis=1)),
             mesh=mesh,
+            dense=dense,
         )
 
     # ------------------------------------------------------------------ properties
@@ -124,7 +246,12 @@ class NodeGraph:
         """Mean centre-to-centre distance over all edges."""
         return float(self.adjacency.data.mean()) if self.adjacency.nnz else 0.0
 
-    # ------------------------------------------------------------------ queries
+    @property
+    def max_edge_length(self) -> float:
+        """The longest centre-to-centre edge."""
+        return float(self.adjacency.data.max()) if self.adjacency.nnz else 0.0
+
+    # ------------------------------------------------------------------ locating
     def node_at(self, x: float, y: float) -> int:
         """The node whose cell or triangle contains (x, y); the nearest node otherwise."""
         if self.cell_node is not None:
@@ -149,12 +276,197 @@ class NodeGraph:
         d2 = np.sum((self.positions - (x, y)) ** 2, axis=1)
         return int(np.argmin(d2))
 
+    # ------------------------------------------------------------------ hop distances
+    def hops_from(self, src: int | Sequence[int] | np.ndarray, max_hops: int | None = None) -> np.ndarray:
+        """BFS hop distances from ``src`` (an int: (n,); several: (k, n)), int32, read-only.
+
+        :data:`UNREACHABLE_HOPS` where unreachable or farther than ``max_hops``; a bounded
+        search on a large graph only visits the ball of radius ``max_hops``.
+        """
+        if not np.isscalar(src) and np.ndim(src) > 0:
+            nodes = np.asarray(src, dtype=np.intp)
+            if self.dense and max_hops is None:
+                return self._hops[nodes]
+            return np.stack([self.hops_from(int(s), max_hops) for s in nodes]) if len(nodes) else (
+                np.zeros((0, self.n), dtype=np.int32)
+            )
+        s = int(src)
+        if self.dense:
+            row = self._hops[s]
+            if max_hops is None:
+                return row
+            out = np.where(row <= max_hops, row, UNREACHABLE_HOPS).astype(np.int32)
+            out.flags.writeable = False
+            return out
+        limit = np.inf if max_hops is None else float(max_hops)
+        (row,) = self._rows.get(
+            ("hops", s, max_hops),
+            lambda: (_as_hops(dijkstra(self.adjacency, indices=s, unweighted=True, limit=limit)),),
+        )
+        return row
+
+    def hops_between(self, a: int | np.ndarray | Sequence[int], b: int | np.ndarray | Sequence[int]) -> np.ndarray | int:
+        """Hop distance of each pair (a[i], b[i]) (broadcast like numpy indexing)."""
+        if self.dense:
+            found = self._hops[a, b]
+            return int(found) if np.ndim(found) == 0 else found
+        a_arr, b_arr = np.broadcast_arrays(np.asarray(a, dtype=np.intp), np.asarray(b, dtype=np.intp))
+        out = np.empty(a_arr.shape, dtype=np.int32)
+        for s in np.unique(a_arr):
+            mask = a_arr == s
+            out[mask] = self.hops_from(int(s))[b_arr[mask]]
+        return int(out) if out.ndim == 0 else out
+
+    # ------------------------------------------------------------------ metric distances
+    def _dist_pred(self, s: int) -> tuple[np.ndarray, np.ndarray]:
+        if self.dense:
+            return self._dist[s], self._pred[s]
+        dist, pred = self._rows.get(
+            ("dist", s),
+            lambda: tuple(dijkstra(self.adjacency, directed=False, indices=s, return_predecessors=True)),
+        )
+        return dist, pred
+
+    def dist_from(self, src: int | Sequence[int] | np.ndarray, limit: float | None = None) -> np.ndarray:
+        """Shortest-path distances from ``src`` (an int: (n,); several: (k, n)), read-only.
+
+        ``inf`` where unreachable or (with ``limit``) farther than ``limit``; a limited
+        search on a large graph only visits the nodes within it. Row i is the search from
+        ``src[i]``: d(a, b) is summed from a, so it may differ from d(b, a) in the last bit.
+        """
+        if not np.isscalar(src) and np.ndim(src) > 0:
+            nodes = np.asarray(src, dtype=np.intp)
+            if self.dense and limit is None:
+                return self._dist[nodes]
+            if not len(nodes):
+                return np.zeros((0, self.n))
+            return np.stack([self.dist_from(int(s), limit) for s in nodes])
+        s = int(src)
+        if limit is None:
+            return self._dist_pred(s)[0]
+        if self.dense:
+            row = self._dist[s]
+            out = np.where(row <= limit, row, np.inf)
+        else:
+            out = dijkstra(self.adjacency, indices=s, limit=float(limit))  # symmetric: no transpose
+        out.flags.writeable = False
+        return out
+
+    def dist_between(self, a: int | np.ndarray | Sequence[int], b: int | np.ndarray | Sequence[int]) -> np.ndarray | float:
+        """d(a[i], b[i]) of each pair (broadcast like numpy indexing), searched from a."""
+        if self.dense:
+            found = self._dist[a, b]
+            return float(found) if np.ndim(found) == 0 else found
+        a_arr, b_arr = np.broadcast_arrays(np.asarray(a, dtype=np.intp), np.asarray(b, dtype=np.intp))
+        out = np.empty(a_arr.shape, dtype=np.float64)
+        for s in np.unique(a_arr):
+            mask = a_arr == s
+            out[mask] = self.dist_from(int(s))[b_arr[mask]]
+        return float(out) if out.ndim == 0 else out
+
+    def nearest_dist(
+        self,
+        srcs: Sequence[int] | np.ndarray,
+        limit: float | None = None,
+        around: int | None = None,
+        reach: float = 0.0,
+    ) -> np.ndarray:
+        """(n,) ``min_s d(s, ·)`` over the sources (one multi-source search on a large graph).
+
+        Equal to ``dist_from(srcs).min(axis=0)`` bit for bit: each node's value is the least
+        rounded path sum from any source either way (a search stopped at a limit leaves the
+        values inside it unchanged). ``inf`` with no source. With ``around``, only the nodes
+        within metric distance ``reach`` of node ``around`` are promised (others may be
+        ``inf``): a large graph then searches no farther than the nearest source's distance
+        to ``around`` plus ``reach``.
+        """
+        nodes = np.asarray(srcs, dtype=np.intp).ravel()
+        if not len(nodes):
+            return np.full(self.n, np.inf)
+        if self.dense:
+            found = self._dist[nodes].min(axis=0)
+            if limit is not None:
+                found = np.where(found <= limit, found, np.inf)
+            return found
+        if around is not None and limit is None:
+            key = tuple(sorted(set(nodes.tolist())))
+            bound = self._reverse_bound(nodes, int(around), key)
+            if not np.isfinite(bound):
+                return np.full(self.n, np.inf)
+            needed = (bound + reach) * (1 + 1e-9) + 1e-9
+            last = self._last_search
+            if last is not None and last[0] == key and last[1] >= needed:
+                return last[2]  # a wider search from the same sources: same values inside
+            row = self._multi_source(nodes, needed)
+            row.flags.writeable = False
+            self._last_search = (key, needed, row)
+            return row
+        if len(nodes) == 1 and limit is None:
+            return self.dist_from(int(nodes[0]))
+        key = ("nearest", tuple(sorted(set(nodes.tolist()))), limit)
+        (row,) = self._rows.get(key, lambda: (self._multi_source(nodes, limit),))
+        return row
+
+    def _multi_source(self, nodes: np.ndarray, limit: float | None) -> np.ndarray:
+        # The adjacency is symmetric, so the directed search gives the undirected distances
+        # without scipy transposing the matrix on every call.
+        return dijkstra(self.adjacency, indices=nodes, min_only=True,
+                        limit=np.inf if limit is None else float(limit))
+
+    def _reverse_bound(self, nodes: np.ndarray, target: int, key: tuple[int, ...]) -> float:
+        """``min_s d(target, s)`` by a search from ``target`` grown until it meets a source.
+
+        Summed from the target's side, so it may differ from ``d(s, target)`` in the last
+        bit: callers use it only as a (padded) search limit. A straight line is a lower
+        bound on a path, so the first limit is already close.
+        """
+        if self._last_bound is not None and self._last_bound[0] == (key, target):
+            return self._last_bound[1]
+        bound = self._grow_reverse(nodes, target)
+        self._last_bound = ((key, target), bound)
+        return bound
+
+    def _grow_reverse(self, nodes: np.ndarray, target: int) -> float:
+        gap = float(np.linalg.norm(self.positions[nodes] - self.positions[target], axis=1).min())
+        limit = 1.25 * gap + 2.0 * self.max_edge_length
+        reached = -1
+        while True:
+            row = dijkstra(self.adjacency, indices=target, limit=limit)
+            found = row[nodes].min()
+            if np.isfinite(found):
+                return float(found)
+            count = int(np.isfinite(row).sum())
+            if count == reached:  # the search stopped growing: no source in this piece
+                return np.inf
+            reached, limit = count, 2.0 * limit
+
+    def nearest_dist_to(self, srcs: Sequence[int] | np.ndarray, target: int) -> float:
+        """``min_s d(s, target)``: :meth:`nearest_dist` at one node, searching only as far as needed."""
+        nodes = np.asarray(srcs, dtype=np.intp).ravel()
+        if not len(nodes):
+            return np.inf
+        if self.dense:
+            return float(self._dist[nodes, target].min())
+        return float(self.nearest_dist(nodes, around=target)[target])
+
+    def components(self) -> np.ndarray:
+        """(n,) label of every node's connected piece."""
+        if self._labels is None:
+            _, self._labels = connected_components(self.adjacency, directed=False)
+        return self._labels
+
+    def reachable_from(self, node: int) -> np.ndarray:
+        """(n,) bool: the nodes connected to ``node`` (``isfinite(dist_from(node))``)."""
+        labels = self.components()
+        return labels == labels[int(node)]
+
+    # ------------------------------------------------------------------ paths
     def shortest_path(self, a: int, b: int) -> list[int]:
         """Nodes of the metric shortest path from a to b, both included."""
         if a == b:
             return [a]
         path = [b]
-        pred = self._pred[a]
+        pred = self._dist_pred(int(a))[1]
         while path[-1] != a:
             prev = int(pred[path[-1]])
             if prev < 0:
@@ -176,9 +488,49 @@ class NodeGraph:
         path = self.shortest_path(a, b)
         if len(path) == 1:
             return a
-        along = self.dist[a, path]
+        along = self.dist_from(int(a))[path]
         within = np.nonzero(along <= horizon + 1e-9)[0]
         return path[max(1, int(within[-1]))]
+
+
+def _pack(table: np.ndarray) -> Neighbours:
+    """Neighbour lists from an (n, k) table padded with negative entries, row order kept."""
+    table = np.asarray(table, dtype=np.int64)
+    valid = table >= 0
+    indptr = np.zeros(len(table) + 1, dtype=np.int64)
+    np.cumsum(valid.sum(axis=1), out=indptr[1:])
+    return Neighbours(indptr, table[valid])
+
+
+def hop_ball_pairs(graph: NodeGraph, radius: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Every pair (x, y) with ``hops(x, y) ≤ radius``: rows, cols and hops, in row-major order.
+
+    A truncated BFS from every node at once by sparse products: with ``R_k`` the pairs
+    within k hops (``R_k = R_{k-1} (I + A)``), ``Σ_{k ≤ radius} R_k`` counts
+    ``radius + 1 − hops``. Memory grows with the ball sizes, not with n².
+    """
+    from scipy.sparse import identity
+
+    n = graph.n
+    step = (graph.adjacency != 0).astype(np.int32) + identity(n, dtype=np.int32, format="csr")
+    reach = identity(n, dtype=np.int32, format="csr")
+    counts = reach.copy()
+    for _ in range(int(radius)):
+        reach = reach @ step
+        reach.data[:] = 1
+        counts = counts + reach
+    counts = counts.tocsr()
+    counts.sum_duplicates()
+    counts.sort_indices()
+    coo = counts.tocoo()
+    hops = (int(radius) + 1 - coo.data).astype(np.int64)
+    return coo.row.astype(np.intp), coo.col.astype(np.intp), hops
+
+
+def dense_bytes(n_nodes: int) -> int:
+    """Bytes of the dense all-pairs matrices of an n-node graph (int32 hops and predecessors,
+    float64 distances)."""
+    return 16 * n_nodes * n_nodes
 
 
 def build_graph(level: Level, abstraction: str) -> NodeGraph:
@@ -215,3 +567,48 @@ def graph_for(level: Level, abstraction: str) -> NodeGraph:
     if level.digest is not None:
         return _cached_graph(_GraphKey(level.digest, abstraction, level))
     return build_graph(level, abstraction)
+
+
+#: Bytes a graph needs per node beyond dense matrices, measured with margin: CSR adjacency
+#: and neighbour lists, the radius-3 kernel, candidate sets, per-node world arrays.
+BYTES_PER_NODE = 4096
+
+
+def estimate_bytes(level: Level) -> tuple[int, int]:
+    """(nodes, bytes) a level needs to run, from its size alone, before building anything.
+
+    Nodes: the larger of the walkable cells and twice the walkable polygon's vertices (a
+    triangulation's triangle count). Bytes: per node, plus the dense matrices below
+    :data:`DENSE_MAX_NODES`, plus the bounded row caches.
+    """
+    cells = int(level.occupancy.sum())
+    vertices = len(level.walkable.exterior.coords) + sum(len(r.coords) for r in level.walkable.interiors)
+    nodes = max(cells, 2 * vertices)
+    dense = dense_bytes(nodes) if nodes <= DENSE_MAX_NODES else 0
+    return nodes, nodes * BYTES_PER_NODE + dense + 2 * ROW_CACHE_BYTES
+
+
+def available_bytes() -> int | None:
+    """Memory the machine can still give (``MemAvailable``), None where unknown."""
+    try:
+        with open("/proc/meminfo", encoding="ascii") as meminfo:
+            for line in meminfo:
+                if line.startswith("MemAvailable:"):
+                    return int(line.split()[1]) * 1024
+    except OSError:
+        return None
+    return None
+
+
+def check_fits(level: Level, source: str) -> None:
+    """Raise a one-line :class:`~navmesh.level.LevelError` if the level cannot run here."""
+    from .errors import LevelError
+
+    nodes, need = estimate_bytes(level)
+    have = available_bytes()
+    if have is not None and need > have:
+        raise LevelError(
+            source, "size",
+            f"{level.rows}x{level.cols} cells, about {nodes} nodes: needs about "
+            f"{need / 2**30:.1f} GB to run, {have / 2**30:.1f} GB available",
+        )

@@ -129,8 +129,8 @@ def test_information_overlay_changes_after_a_sighting() -> None:
         for _ in range(50):  # step into plain sight of guard 0 until it sees the player
             guard = world.guards[0]
             spot = next(
-                int(n) for n in np.argsort(graph.dist[guard.node])
-                if 2.0 <= graph.dist[guard.node, n] <= 4.0
+                int(n) for n in np.argsort(graph.dist_from(guard.node))
+                if 2.0 <= graph.dist_between(guard.node, n) <= 4.0
                 and world.sees(guard, tuple(graph.positions[n]))
             )
             world.player.place(tuple(graph.positions[spot]))

@@ -28,9 +28,10 @@ def test_grid_nodes_positions_and_neighbours() -> None:
 
 def test_hop_and_metric_distances_and_paths() -> None:
     g = l_shape()
-    assert g.hops[0].tolist() == [0, 1, 2, 3, 4]
-    assert g.dist[0, 4] == pytest.approx(8.0)  # four edges of length 2
-    assert np.array_equal(g.hops, g.hops.T) and np.allclose(g.dist, g.dist.T)
+    assert g.hops_from(0).tolist() == [0, 1, 2, 3, 4]
+    assert g.dist_between(0, 4) == pytest.approx(8.0)  # four edges of length 2
+    hops, dist = g.hops_from(range(g.n)), g.dist_from(range(g.n))
+    assert np.array_equal(hops, hops.T) and np.allclose(dist, dist.T)
     assert g.shortest_path(0, 4) == [0, 1, 2, 3, 4]
     assert g.shortest_path(3, 3) == [3]
     assert g.next_hop(0, 4) == 1
@@ -58,7 +59,7 @@ def test_partition_graph_is_the_mesh_dual(name: str) -> None:
         for u in nbs:
             assert t in g.neighbors[u]
             assert len(set(mesh.triangles[t]) & set(mesh.triangles[u])) == 2
-    assert (g.hops < g.n).all()  # one connected piece
+    assert (g.hops_from(0) < g.n).all()  # one connected piece
     for t in (0, g.n // 2):
         assert g.node_at(*mesh.centroids[t]) == t
         assert g.node_near(*mesh.centroids[t], hint=t) == t

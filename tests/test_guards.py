@@ -67,10 +67,10 @@ def test_pf_guard_heads_for_a_fresh_sighting() -> None:
     guards.reset(graph, np.random.default_rng(0), 1)
     node, target = 0, 48
     guards.tick(make_view(graph, [node], target, sighting=target), 1.0)
-    distances = [int(graph.hops[node, target])]
+    distances = [int(graph.hops_between(node, target))]
     for step in range(12):
         node = guards.decide(0, make_view(graph, [node], target, t=1 + step / 2))
-        distances.append(int(graph.hops[node, target]))
+        distances.append(int(graph.hops_between(node, target)))
         if step % 2:
             guards.tick(make_view(graph, [node], target, t=1 + step / 2), 1.0)
     assert distances == list(range(12, -1, -1))  # one cell closer at every decision
@@ -82,7 +82,7 @@ def test_pf_guards_spread_out_instead_of_following(start: list[int]) -> None:
     guards = PotentialFieldGuards()
     guards.reset(graph, np.random.default_rng(3), 2)
     history = simulate(guards, graph, list(start), player=0, ticks=30)
-    apart = graph.hops[history[:, 0], history[:, 1]]
+    apart = graph.hops_between(history[:, 0], history[:, 1])
     # Two followers would stay within one hop all the time. Confidence and teammate
     # presence push them apart; the revisit penalty (eq. 10) trades a little of that for
     # coverage (start [39, 38]: within one hop 21 % of the time instead of 11 %).
@@ -133,7 +133,7 @@ def test_pf_moves_to_a_grid_neighbour_every_decision() -> None:
     guards = PotentialFieldGuards()
     guards.reset(graph, np.random.default_rng(1), 3)
     history = simulate(guards, graph, [0, 17, 35], player=20, ticks=10)
-    steps = graph.hops[history[:-1], history[1:]]
+    steps = graph.hops_between(history[:-1], history[1:])
     assert np.all(steps == 1)
 
 
@@ -338,7 +338,7 @@ def test_fsm_patrol_targets_are_distinct_and_moves_are_single_cells() -> None:
     guards = FSMGuards()
     guards.reset(graph, np.random.default_rng(4), 3)
     history = simulate(guards, graph, [0, 5, 30], player=20, ticks=12)
-    assert np.all(graph.hops[history[:-1], history[1:]] <= 1)
+    assert np.all(graph.hops_between(history[:-1], history[1:]) <= 1)
     targets = [g.target for g in guards.guards]
     assert len(set(targets)) == 3
 
@@ -348,7 +348,7 @@ def test_fsm_investigates_a_strong_stimulus_layer_only() -> None:
     guards = FSMGuards()
     guards.reset(graph, np.random.default_rng(0), 1)
     # footstep-like layer −3·0.6^d around node 8: 3·0.6² = 1.08 ≥ 1 at d = 2, 0.648 at d = 3
-    layer = -3.0 * 0.6 ** graph.hops[8].astype(float)
+    layer = -3.0 * 0.6 ** graph.hops_from(8).astype(float)
     guards.extra_information = layer
     guards.tick(make_view(graph, [5], 0), 1.0)  # d = 3: too faint
     assert guards.state_name(0) == "patrol"
@@ -383,7 +383,7 @@ def test_staleness_guard_heads_for_the_stalest_region() -> None:
     target = guards.guards[0].target
     assert target is not None and graph.node_cell[target][1] < 5
     assert guards.staleness[target] == guards.staleness.max() == 15.0
-    assert graph.hops[first, target] == graph.hops[start, target] - 1  # on its way there
+    assert graph.hops_between(first, target) == graph.hops_between(start, target) - 1  # on its way there
 
 
 def test_staleness_guards_never_share_a_target() -> None:

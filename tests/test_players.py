@@ -45,10 +45,10 @@ def test_player_moves_away_from_a_nearby_guard_in_the_open(name: str) -> None:
     player = policy(name, graph)
     checked = 0
     for node in (int(graph.cell_node[r, c]) for r in range(5, 10) for c in range(5, 10)):
-        for guard in np.flatnonzero((graph.hops[node] >= 2) & (graph.hops[node] <= 5)):
+        for guard in np.flatnonzero((graph.hops_from(node) >= 2) & (graph.hops_from(node) <= 5)):
             chosen = player.decide(make_view(graph, [int(guard)], node))
-            assert graph.hops[node, chosen] == 1
-            assert graph.dist[guard, chosen] > graph.dist[guard, node]
+            assert graph.hops_between(node, chosen) == 1
+            assert graph.dist_between(guard, chosen) > graph.dist_between(guard, node)
             checked += 1
     assert checked == 1400
 
@@ -60,10 +60,10 @@ def test_player_escapes_a_guard_walking_at_it(name: str) -> None:
     guard, node = int(graph.cell_node[3, 0]), int(graph.cell_node[3, 3])
     for _ in range(6):  # the guard walks straight at the player, one cell per player move
         new = player.decide(make_view(graph, [guard], node))
-        assert graph.dist[guard, new] >= graph.dist[guard, node]
+        assert graph.dist_between(guard, new) >= graph.dist_between(guard, node)
         node = new
         guard = graph.step_towards(guard, node, 1.01)
-    assert graph.dist[guard, node] >= 3
+    assert graph.dist_between(guard, node) >= 3
 
 
 @pytest.mark.parametrize("name", POLICIES)
@@ -95,8 +95,8 @@ def test_maxmin_enumerates_every_sequence_with_staying_put() -> None:
     centre = int(graph.cell_node[3, 3])
     paths = sequences.from_node(centre)
     assert paths.shape == (125, 3)  # 5 options (4 neighbours + stay) per step
-    assert np.all(graph.hops[centre, paths[:, 0]] <= 1)
-    assert np.all(graph.hops[paths[:, 0], paths[:, 1]] <= 1)
+    assert np.all(graph.hops_between(centre, paths[:, 0]) <= 1)
+    assert np.all(graph.hops_between(paths[:, 0], paths[:, 1]) <= 1)
     assert len({tuple(p) for p in paths.tolist()}) == 125
     # from a corner: stay, right, down; then 3 + 4 + 4 options
     assert move_sequences(open_grid(5, 5), 2).from_node(0).shape == (11, 2)
@@ -112,7 +112,7 @@ def test_maxmin_looks_ahead_out_of_a_dead_end() -> None:
     graph = NodeGraph.from_grid(occupancy, 1.0)
     guard, node = int(graph.cell_node[0, 8]), int(graph.cell_node[0, 5])
     stub, left = int(graph.cell_node[1, 5]), int(graph.cell_node[0, 4])
-    assert graph.dist[guard, stub] == graph.dist[guard, left]
+    assert graph.dist_between(guard, stub) == graph.dist_between(guard, left)
     for seed in range(5):
         assert policy("maxmin", graph, seed).decide(make_view(graph, [guard], node)) == left
     greedy = {

@@ -380,7 +380,7 @@ def test_dark_zone_decay_is_applied_by_the_world():
     tick(w)
     before = w.guard_ai.field.confidence.copy()
     tick(w)
-    deposit = w.guard_ai.field.matrices.conf_spread[[g.node for g in w.guards]].sum(axis=0)
+    deposit = w.guard_ai.field.matrices.deposit([g.node for g in w.guards])
     expected = np.where(dark, 0.80, 0.95) * before + deposit
     np.testing.assert_allclose(w.guard_ai.field.confidence, expected)
     w2 = world(level, make_guard_ai("pf"), ["zones.dark_confidence_decay=0.5"])
