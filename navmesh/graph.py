@@ -76,7 +76,7 @@ class Neighbours(Sequence[np.ndarray]):
     def __len__(self) -> int:
         return len(self.indptr) - 1
 
-    def __getitem__(self, node):  # type: ignore[no-untyped-def,override]
+    def __getitem__(self, node):  # type: ignore[no-untyped-def,unused-ignore]
         if isinstance(node, slice):
             return [self[i] for i in range(*node.indices(len(self)))]
         node = int(node)
@@ -169,7 +169,7 @@ class NodeGraph:
     adjacency: csr_matrix = field(init=False, repr=False)
 
     def __post_init__(self) -> None:
-        self.neighbors = Neighbours.from_lists(self.neighbors)
+        self.neighbors = Neighbours.from_lists(self.neighbors)  # type: ignore[arg-type]
         n = len(self.positions)
         nb = self.neighbors
         rows = np.repeat(np.arange(n), np.diff(nb.indptr))
@@ -290,7 +290,7 @@ class NodeGraph:
             return np.stack([self.hops_from(int(s), max_hops) for s in nodes]) if len(nodes) else (
                 np.zeros((0, self.n), dtype=np.int32)
             )
-        s = int(src)
+        s = int(src)  # type: ignore[arg-type]
         if self.dense:
             row = self._hops[s]
             if max_hops is None:
@@ -341,7 +341,7 @@ class NodeGraph:
             if not len(nodes):
                 return np.zeros((0, self.n))
             return np.stack([self.dist_from(int(s), limit) for s in nodes])
-        s = int(src)
+        s = int(src)  # type: ignore[arg-type]
         if limit is None:
             return self._dist_pred(s)[0]
         if self.dense:
@@ -403,8 +403,8 @@ class NodeGraph:
             return row
         if len(nodes) == 1 and limit is None:
             return self.dist_from(int(nodes[0]))
-        key = ("nearest", tuple(sorted(set(nodes.tolist()))), limit)
-        (row,) = self._rows.get(key, lambda: (self._multi_source(nodes, limit),))
+        nearest_key = ("nearest", tuple(sorted(set(nodes.tolist()))), limit)
+        (row,) = self._rows.get(nearest_key, lambda: (self._multi_source(nodes, limit),))
         return row
 
     def _multi_source(self, nodes: np.ndarray, limit: float | None) -> np.ndarray:
