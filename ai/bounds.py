@@ -31,6 +31,8 @@ def _number(x: float) -> str:
     """``0.0`` as ``0``, ``inf`` as ``inf``: bounds read like the docs write them."""
     if math.isinf(x):
         return "inf" if x > 0 else "-inf"
+    if isinstance(x, int) or x.is_integer():
+        return str(int(x))
     return f"{x:g}"
 
 
