@@ -2,7 +2,9 @@
 
 Every controller receives its parameters as a plain dict (from the config file's section of
 its mode) and turns it into one of these frozen dataclasses with ``from_mapping``, so a typo
-or an out-of-range value fails when the controller is built, not silently in a sweep.
+or an out-of-range value fails when the controller is built, not silently in a sweep. Each
+class declares the allowed values of every field once, in ``bounds`` (:mod:`ai.bounds`);
+the config schema (``game.schema``) checks the config keys against the same declarations.
 
 >>> PFParams.from_mapping({"rho": 0.9}).rho
 0.9
@@ -10,23 +12,29 @@ or an out-of-range value fails when the controller is built, not silently in a s
 Traceback (most recent call last):
 ...
 ValueError: PFParams: unknown parameter 'roh' (known: I0, C0, gamma_I, gamma_C, rho, ...)
+>>> PFParams.from_mapping({"rho": 1.5})
+Traceback (most recent call last):
+...
+ValueError: PFParams: rho must be in (0, 1], got 1.5
 """
 
 from __future__ import annotations
 
-import math
 from collections.abc import Mapping
 from dataclasses import dataclass, fields
-from typing import Any, TypeVar
+from typing import Any, ClassVar, TypeVar
+
+from .bounds import ANY_NUMBER, COUNT, FLAG, FRACTION, NON_NEGATIVE, POSITIVE, UNIT, Bound, Range
 
 _P = TypeVar("_P", bound="_Params")
 
 
 class _Params:
-    """Shared ``from_mapping`` and range checks of the parameter dataclasses."""
+    """Shared ``from_mapping`` and bound checks of the parameter dataclasses."""
 
-    #: name -> (low, high, low_inclusive, high_inclusive); checked in ``__post_init__``
-    _ranges: dict[str, tuple[float, float, bool, bool]] = {}
+    #: field name -> its allowed values (:mod:`ai.bounds`), one declaration per field; the
+    #: config schema (``game.schema``) reads these for the keys of the section
+    bounds: ClassVar[Mapping[str, Bound]] = {}
 
     @classmethod
     def from_mapping(cls: type[_P], params: Mapping[str, Any] | None = None) -> _P:
@@ -43,39 +51,14 @@ class _Params:
     def __post_init__(self) -> None:
         for f in fields(self):  # type: ignore[arg-type]
             value = getattr(self, f.name)
-            kind = f.type if isinstance(f.type, str) else getattr(f.type, "__name__", "")
-            if kind == "bool":
-                if not isinstance(value, bool):
-                    raise ValueError(
-                        f"{type(self).__name__}: {f.name} must be true or false, got {value!r}"
-                    )
-                continue
-            if isinstance(value, bool) or not isinstance(value, (int, float)):
-                raise ValueError(f"{type(self).__name__}: {f.name} must be a number, got {value!r}")
-            if not math.isfinite(value):
-                raise ValueError(f"{type(self).__name__}: {f.name} must be finite, got {value!r}")
-            if kind == "int":
-                if int(value) != value:
-                    raise ValueError(
-                        f"{type(self).__name__}: {f.name} must be a whole number, got {value!r}"
-                    )
-                object.__setattr__(self, f.name, int(value))
-            elif kind == "float":
-                object.__setattr__(self, f.name, float(value))
-            if f.name in self._ranges:
-                low, high, low_in, high_in = self._ranges[f.name]
-                ok_low = value >= low if low_in else value > low
-                ok_high = value <= high if high_in else value < high
-                if not (ok_low and ok_high):
-                    span = f"{'[' if low_in else '('}{low}, {high}{']' if high_in else ')'}"
-                    raise ValueError(
-                        f"{type(self).__name__}: {f.name} must be in {span}, got {value!r}"
-                    )
-
-
-_UNIT = (0.0, 1.0, False, True)  # (0, 1]
-_POSITIVE = (0.0, math.inf, False, False)
-_NON_NEGATIVE = (0.0, math.inf, True, False)
+            bound = self.bounds.get(f.name)
+            if bound is None:
+                raise TypeError(f"{type(self).__name__}: {f.name} declares no bound")
+            problem = bound.problem(value)
+            if problem is not None:
+                raise ValueError(f"{type(self).__name__}: {f.name} {problem}, got {value!r}")
+            if isinstance(bound, Range):
+                object.__setattr__(self, f.name, int(value) if bound.integer else float(value))
 
 
 @dataclass(frozen=True)
@@ -103,23 +86,23 @@ class PFParams(_Params):
     #: (docs/ai.md "Revisit penalty"); 0 = the paper's field only
     revisit_penalty: float = 0.5
 
-    _ranges = {
-        "teammate_presence": _NON_NEGATIVE,
-        "revisit_penalty": _NON_NEGATIVE,
-        "I0": _NON_NEGATIVE,
-        "C0": _NON_NEGATIVE,
-        "gamma_I": _UNIT,
-        "gamma_C": _UNIT,
-        "rho": _UNIT,
-        "kernel_lambda": _UNIT,
-        "kernel_radius": (0, math.inf, True, False),
-        "w_I_base": (0.0, 1.0, True, True),
-        "w_C_patrol": _NON_NEGATIVE,
-        "w_N_patrol": _NON_NEGATIVE,
-        "w_I_max": (0.0, 1.0, True, True),
-        "weight_decay": _NON_NEGATIVE,
-        "r_edge_factor": _POSITIVE,
-        "tie_eps": _NON_NEGATIVE,
+    bounds = {
+        "teammate_presence": NON_NEGATIVE,
+        "revisit_penalty": NON_NEGATIVE,
+        "I0": NON_NEGATIVE,
+        "C0": NON_NEGATIVE,
+        "gamma_I": UNIT,
+        "gamma_C": UNIT,
+        "rho": UNIT,
+        "kernel_lambda": UNIT,
+        "kernel_radius": COUNT,
+        "w_I_base": FRACTION,
+        "w_C_patrol": NON_NEGATIVE,
+        "w_N_patrol": NON_NEGATIVE,
+        "w_I_max": FRACTION,
+        "weight_decay": NON_NEGATIVE,
+        "r_edge_factor": POSITIVE,
+        "tie_eps": POSITIVE,  # ties are scores within tie_eps of the best: 0 ties nothing
     }
 
     def __post_init__(self) -> None:
@@ -145,14 +128,14 @@ class FSMParams(_Params):
     return_max: float = 5.0
     r_edge_factor: float = 2.5  # partition step horizon = factor × mean edge length
 
-    _ranges = {
-        "info_threshold": _NON_NEGATIVE,
-        "sighting_information": _NON_NEGATIVE,
-        "t_investigate": _NON_NEGATIVE,
-        "t_lose_sight": _NON_NEGATIVE,
-        "chase_max": _NON_NEGATIVE,
-        "return_max": _NON_NEGATIVE,
-        "r_edge_factor": _POSITIVE,
+    bounds = {
+        "info_threshold": NON_NEGATIVE,
+        "sighting_information": NON_NEGATIVE,
+        "t_investigate": NON_NEGATIVE,
+        "t_lose_sight": NON_NEGATIVE,
+        "chase_max": NON_NEGATIVE,
+        "return_max": NON_NEGATIVE,
+        "r_edge_factor": POSITIVE,
     }
 
 
@@ -162,7 +145,7 @@ class StalenessParams(FSMParams):
 
     increment: float = 1.0
 
-    _ranges = {**FSMParams._ranges, "increment": _NON_NEGATIVE}
+    bounds = {**FSMParams.bounds, "increment": NON_NEGATIVE}
 
 
 @dataclass(frozen=True)
@@ -181,14 +164,15 @@ class PlayerParams(_Params):
     r_edge_factor: float = 2.5  # partition step horizon of SafetyGraph
     tie_eps: float = 1e-9
 
-    _ranges = {
-        "maxmin_depth": (1, 6, True, True),
-        "guard_speed": _POSITIVE,
-        "player_speed": _POSITIVE,
-        "safety_margin": (-math.inf, math.inf, False, False),
-        "safety_penalty": _NON_NEGATIVE,
-        "r_edge_factor": _POSITIVE,
-        "tie_eps": _NON_NEGATIVE,
+    bounds = {
+        "maxmin_depth": Range(1, 6, integer=True),
+        "maxmin_guards_advance": FLAG,
+        "guard_speed": POSITIVE,
+        "player_speed": POSITIVE,
+        "safety_margin": ANY_NUMBER,
+        "safety_penalty": NON_NEGATIVE,
+        "r_edge_factor": POSITIVE,
+        "tie_eps": NON_NEGATIVE,
     }
 
 

@@ -32,20 +32,20 @@ Distances are hop distances on the node graph (``graph.hops_from``), as everywhe
 from __future__ import annotations
 
 import importlib.util
-import math
 import sys
 import zlib
 from collections.abc import Callable, Iterable, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, NamedTuple
+from typing import Any, ClassVar, NamedTuple
 
 import numpy as np
 
 from navmesh.graph import UNREACHABLE_HOPS, NodeGraph
 
 from .errors import StimulusError
-from .params import _NON_NEGATIVE, _POSITIVE, _UNIT, _Params
+from .bounds import COUNT, FLAG, FRACTION, NON_NEGATIVE, UNIT, Bound
+from .params import _Params
 from .view import Event, GuardAI, WorldView
 
 #: importlib.metadata entry-point group under which installed packages register stimuli
@@ -90,23 +90,24 @@ class StimulusParams(_Params):
     #: a guard within this many hops of a decoy or corpse counts as standing on / inspecting it
     inspect_hops: int = 1
 
-    _ranges = {
-        "noise_amplitude": _NON_NEGATIVE,
-        "noise_falloff": _UNIT,
-        "noise_max_hops": (0, math.inf, True, False),
-        "noise_decay": _UNIT,
-        "noise_threshold": _NON_NEGATIVE,
-        "rain_amplitude_scale": _NON_NEGATIVE,
-        "rain_falloff": _UNIT,
-        "decoy_amplitude": _NON_NEGATIVE,
-        "decoy_falloff": _UNIT,
-        "decoy_disarm_time": _NON_NEGATIVE,
-        "corpse_amplitude": _NON_NEGATIVE,
-        "corpse_decay": _UNIT,
-        "corpse_falloff": _UNIT,
-        "corpse_inspect_time": _NON_NEGATIVE,
-        "corpse_alert_weight": (0.0, 1.0, True, True),
-        "inspect_hops": (0, math.inf, True, False),
+    bounds = {
+        "noise_amplitude": NON_NEGATIVE,
+        "noise_falloff": UNIT,
+        "noise_max_hops": COUNT,
+        "noise_decay": UNIT,
+        "noise_threshold": NON_NEGATIVE,
+        "rain_amplitude_scale": NON_NEGATIVE,
+        "rain_falloff": UNIT,
+        "raining": FLAG,
+        "decoy_amplitude": NON_NEGATIVE,
+        "decoy_falloff": UNIT,
+        "decoy_disarm_time": NON_NEGATIVE,
+        "corpse_amplitude": NON_NEGATIVE,
+        "corpse_decay": UNIT,
+        "corpse_falloff": UNIT,
+        "corpse_inspect_time": NON_NEGATIVE,
+        "corpse_alert_weight": FRACTION,
+        "inspect_hops": COUNT,
     }
 
 
@@ -607,11 +608,15 @@ class Zone:
     confidence_decay: float | None = None
     view_scale: float = 1.0
 
+    #: allowed values of the two settings; config keys ``zones.<kind>_<setting>`` (game.schema)
+    bounds: ClassVar[Mapping[str, Bound]] = {"confidence_decay": UNIT, "view_scale": NON_NEGATIVE}
+
     def __post_init__(self) -> None:
-        if self.confidence_decay is not None and not 0 < self.confidence_decay <= 1:
-            raise ValueError(f"zone {self.kind}: confidence_decay must be in (0, 1]")
-        if not 0 <= self.view_scale:
-            raise ValueError(f"zone {self.kind}: view_scale must be >= 0")
+        for name, bound in self.bounds.items():
+            value = getattr(self, name)
+            problem = None if value is None else bound.problem(value)
+            if problem is not None:
+                raise ValueError(f"zone {self.kind}: {name} {problem}, got {value!r}")
 
 
 def zones_from_config(section: Mapping[str, Any]) -> dict[str, Zone]:

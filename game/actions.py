@@ -19,7 +19,8 @@ from typing import TYPE_CHECKING, Any, cast
 
 import numpy as np
 
-from ai.params import _NON_NEGATIVE, _POSITIVE, _Params
+from ai.bounds import COUNT, NON_NEGATIVE, POSITIVE
+from ai.params import _Params
 from ai.view import PLAYER_ACTIONS, Action, Event
 from navmesh.level import Level
 
@@ -52,11 +53,11 @@ class ActionParams(_Params):
     #: take-down: guard centre within this distance of the player's, player outside its cone
     takedown_range: float = 1.0
 
-    _ranges = {
-        "throw_cooldown": _NON_NEGATIVE,
-        "throw_radius": (0, math.inf, True, False),
-        "decoy_reach": _NON_NEGATIVE,
-        "takedown_range": _POSITIVE,
+    bounds = {
+        "throw_cooldown": NON_NEGATIVE,
+        "throw_radius": COUNT,
+        "decoy_reach": NON_NEGATIVE,
+        "takedown_range": POSITIVE,
     }
 
     @classmethod

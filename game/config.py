@@ -1,14 +1,17 @@
 """Trial configuration: one TOML file of documented defaults plus ``key=value`` overrides.
 
 Keys are dotted paths into the TOML tables (``world.view_range``, ``pf.rho``,
-``scenario.capture.view_range_scale``). An override must name an existing key and is
-converted to that key's type, so a typo or a wrong value fails loudly instead of running a
-sweep with a silently ignored setting. Every trial records the config it ran with and its
+``scenario.capture.view_range_scale``). An override must name an existing key, is
+converted to that key's type and must lie in the key's declared bound (``game.schema``,
+listed in docs/config.md): :func:`check_value` is the one check of every ``--set``, preset
+``[set]`` and config value, so a typo or a wrong value fails loudly before anything runs
+instead of running a sweep with a silently ignored or crashing setting. Every trial records the config it ran with and its
 hash.
 """
 
 from __future__ import annotations
 
+import functools
 import hashlib
 import json
 import tomllib
@@ -16,7 +19,10 @@ from collections.abc import Iterable, Mapping
 from pathlib import Path
 from typing import Any
 
+from ai.bounds import FLAG, Bound, Range
 from game.errors import ConfigError
+
+from .schema import bound_of, check_sections
 
 DEFAULTS_PATH = Path(__file__).with_name("defaults.toml")
 
@@ -32,36 +38,66 @@ def _flatten(table: Mapping[str, Any], prefix: str = "") -> dict[str, Any]:
     return flat
 
 
-def _coerce(key: str, text: Any, like: Any) -> Any:
-    """Convert an override to the type of the default it replaces."""
-    if not isinstance(text, str):
-        value = text
-    elif isinstance(like, bool):
-        lowered = text.strip().lower()
-        if lowered not in ("true", "false", "1", "0", "yes", "no"):
+@functools.cache
+def _default_values() -> dict[str, Any]:
+    with DEFAULTS_PATH.open("rb") as handle:
+        return _flatten(tomllib.load(handle))
+
+
+_WORDS = {"true": True, "1": True, "yes": True, "false": False, "0": False, "no": False}
+
+
+def _parse(key: str, text: str, bound: Bound) -> Any:
+    """A ``--set`` string as the type its key declares (a number, a whole number, a switch)."""
+    if isinstance(bound, Range):
+        try:
+            return int(text) if bound.integer else float(text)
+        except ValueError:
+            what = "a whole number" if bound.integer else "a number"
+            raise ConfigError(f"{key}: expected {what} in {bound.describe()}, got {text!r}") from None
+    if bound == FLAG:
+        word = text.strip().lower()
+        if word not in _WORDS:
             raise ConfigError(f"{key}: expected true or false, got {text!r}")
-        value = lowered in ("true", "1", "yes")
-    elif isinstance(like, int):
-        try:
-            value = int(text)
-        except ValueError:
-            raise ConfigError(f"{key}: expected a whole number, got {text!r}") from None
-    elif isinstance(like, float):
-        try:
-            value = float(text)
-        except ValueError:
-            raise ConfigError(f"{key}: expected a number, got {text!r}") from None
-        if value != value or value in (float("inf"), float("-inf")):
-            raise ConfigError(f"{key}: expected a finite number, got {text!r}")
-    else:
-        value = text
-    if isinstance(like, bool) != isinstance(value, bool) or (
-        isinstance(like, (int, float)) and not isinstance(value, (int, float))
-    ):
-        raise ConfigError(f"{key}: expected {type(like).__name__}, got {value!r}")
-    if isinstance(like, float) and isinstance(value, int):
-        value = float(value)
+        return _WORDS[word]
+    return text
+
+
+def check_value(key: str, value: Any) -> Any:
+    """``value`` as config key ``key`` holds it, or a one-line :class:`ConfigError`.
+
+    The key must exist; a string (``--set``) is parsed as the key's type; the value must lie
+    in the key's declared bound (:func:`game.schema.bound_of`): NaN, infinities, a value out
+    of range, a fraction for a whole-number key all fail, naming the key, the value and the
+    allowed values. Float keys give floats (``6`` -> ``6.0``), whole-number keys ints.
+
+    >>> check_value("world.view_range", "6"), check_value("world.guards", 2.0)
+    (6.0, 2)
+    >>> check_value("pf.rho", 1.5)
+    Traceback (most recent call last):
+    ...
+    game.errors.ConfigError: pf.rho = 1.5: must be in (0, 1]
+    """
+    defaults = _default_values()
+    if key not in defaults:
+        near = [k for k in defaults if k.split(".")[-1] == key.split(".")[-1]]
+        hint = f" (did you mean {near[0]}?)" if near else ""
+        raise ConfigError(f"{key}: unknown config key{hint}")
+    bound = bound_of(key)
+    if isinstance(value, str):
+        value = _parse(key, value, bound)
+    problem = bound.problem(value)
+    if problem is not None:
+        raise ConfigError(f"{key} = {_show(value)}: {problem}")
+    if isinstance(bound, Range):
+        return int(value) if bound.integer else float(value)
     return value
+
+
+def _show(value: Any) -> str:
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    return repr(value) if isinstance(value, str) else str(value)
 
 
 def parse_overrides(items: Iterable[str]) -> list[tuple[str, str]]:
@@ -88,8 +124,7 @@ class Config:
 
     @classmethod
     def defaults(cls) -> Config:
-        with DEFAULTS_PATH.open("rb") as handle:
-            return cls(_flatten(tomllib.load(handle)))
+        return cls(_default_values())
 
     @classmethod
     def load(cls, overrides: Iterable[str] | Mapping[str, Any] = ()) -> Config:
@@ -100,11 +135,8 @@ class Config:
         pairs = list(overrides.items()) if isinstance(overrides, Mapping) else parse_overrides(overrides)
         values = dict(self._values)
         for key, value in pairs:
-            if key not in values:
-                near = [k for k in values if k.split(".")[-1] == key.split(".")[-1]]
-                hint = f" (did you mean {near[0]}?)" if near else ""
-                raise ConfigError(f"{key}: unknown config key{hint}")
-            values[key] = _coerce(key, value, values[key])
+            values[key] = check_value(key, value)
+        check_sections(values)
         return Config(values)
 
     def __getitem__(self, key: str) -> Any:

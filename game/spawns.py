@@ -10,6 +10,7 @@ from navmesh.graph import NodeGraph
 from navmesh.level import Level
 
 from .agents import Agent
+from .schema import SPAWN_RULES
 from .senses import Senses
 
 
@@ -20,7 +21,7 @@ def guard_spawn_nodes(graph: NodeGraph, level: Level, rng: np.random.Generator, 
     if spawns == "level":
         return [graph.node_at(x, y) for x, y in level.guards]
     if spawns != "random":
-        raise ValueError(f"world.spawns: expected 'random' or 'level', got {spawns!r}")
+        raise ValueError(f"world.spawns: expected one of {SPAWN_RULES}, got {spawns!r}")
     count = min(count, graph.n - 1)
     return [int(v) for v in rng.choice(graph.n, size=count, replace=False)]
 

@@ -23,6 +23,7 @@ from .agents import Agent, Locomotion, build_space
 from .config import Config
 from .health import Health
 from .metrics import Counters, world_metrics
+from .schema import check_level
 from .senses import RANGE_EPS, Senses
 from .spawns import guard_spawn_nodes, start_node
 from .zones import ZoneMap
@@ -47,6 +48,7 @@ class World(PlayerActions):
         if scenario not in SCENARIOS:
             raise ValueError(f"unknown scenario {scenario!r} (choose capture or fixed)")
         self.level, self.abstraction, self.scenario = level, abstraction, scenario
+        check_level(config, level)  # a body too wide for the level's corridors: one line
         self.config = config
         self.graph: NodeGraph = graph if graph is not None else graph_for(level, abstraction)
         self.guard_ai, self.player_policy = guard_ai, player_policy

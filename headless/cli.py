@@ -35,6 +35,21 @@ def _point(text: str) -> tuple[float, float]:
     return (x, y)
 
 
+def _seed(text: str) -> int:
+    """A ``--seed``: a whole number inside the declared seed range (``game.schema.SEED``)."""
+    from game.schema import SEED
+
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(
+            f"expected a whole number in {SEED.describe()}, got {text!r}") from None
+    problem = SEED.problem(value)
+    if problem is not None:
+        raise argparse.ArgumentTypeError(f"{value} {problem}")
+    return value
+
+
 def _emit_json(document: Any) -> None:
     json.dump(document, sys.stdout, indent=2)
     sys.stdout.write("\n")
@@ -130,11 +145,13 @@ def cmd_path(args: argparse.Namespace) -> int:
 
 
 # ---------------------------------------------------------------------- sim
-def _overrides(items: Sequence[str]) -> tuple[tuple[str, Any], ...]:
-    """The ``--set`` pairs, every key and value checked now (one-line ConfigError)."""
+def _overrides(items: Sequence[str], level: Any) -> tuple[tuple[str, Any], ...]:
+    """The ``--set`` pairs, every key and value checked now, also against the level
+    (one-line ConfigError before any file is written)."""
     from game.config import Config, parse_overrides
+    from game.schema import check_level
 
-    Config.load(items)
+    check_level(Config.load(items), level)
     return tuple(parse_overrides(items))
 
 
@@ -143,7 +160,7 @@ def cmd_sim(args: argparse.Namespace) -> int:
     from game.trial import TrialSpec, run_trial, sim_document
     from navmesh.level import load_level
 
-    load_level(args.level)  # a bad level fails here with its one-line message
+    level = load_level(args.level)  # a bad level fails here with its one-line message
     for plugin in args.stimulus:
         load_stimulus(plugin)  # a bad plugin fails here with its one-line message
     spec = TrialSpec(
@@ -153,7 +170,7 @@ def cmd_sim(args: argparse.Namespace) -> int:
         player=args.player,
         scenario=args.scenario,
         seed=args.seed,
-        overrides=_overrides(args.set),
+        overrides=_overrides(args.set, level),
         stimuli=tuple(args.stimulus),
     )
     if args.trace:
@@ -313,7 +330,7 @@ def build_parser() -> argparse.ArgumentParser:
                    help="node graph the AI runs on")
     p.add_argument("--scenario", choices=scenarios, default="capture",
                    help="capture: ends at HP 0; fixed: respawn, always the full duration")
-    p.add_argument("--seed", type=int, default=0, help="trial seed")
+    p.add_argument("--seed", type=_seed, default=0, help="trial seed")
     add_set(p)
     add_json(p)
     p.add_argument("--trace", metavar="FILE", default=None,
@@ -368,7 +385,7 @@ def build_parser() -> argparse.ArgumentParser:
                    help="save the last frame as PNG (default: none)")
     p.add_argument("--overlay", default="none",
                    help=f"initial field overlay: {', '.join(OVERLAYS)}")
-    p.add_argument("--seed", type=int, default=0, help="seed of the guards' decisions")
+    p.add_argument("--seed", type=_seed, default=0, help="seed of the guards' decisions")
     add_set(p)
     p.add_argument("--scenario", choices=scenarios, default="capture",
                    help="capture: game over at HP 0; fixed: respawn, play the full duration")

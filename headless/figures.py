@@ -19,6 +19,7 @@ import numpy as np
 
 from game.metrics import TableColumn
 
+from .filenames import output_path
 from .tables import ABSTRACTION_NAMES, GUARD_NAMES, GUARD_SHORT, PLAYER_NAMES, PLAYER_SHORT, label
 from .tables import table_columns
 
@@ -132,7 +133,7 @@ def write_aggregate(rows: Sequence[Mapping[str, Any]], directory: Path) -> list[
     """``aggregate_{abstraction}.png`` per abstraction of ``rows``; returns the files."""
     written = []
     for abstraction in dict.fromkeys(r["abstraction"] for r in rows):
-        path = directory / f"aggregate_{abstraction}.png"
+        path = output_path(directory, "aggregate", abstraction, suffix=".png")
         aggregate_figure(rows, abstraction).savefig(path)
         written.append(path)
     return written

@@ -1,7 +1,8 @@
 """Heatmaps of a results directory: per-node guard visits and attacks, CSV and PNG.
 
 ``heatmaps/{level}_{abstraction}_{mode}_{visit,attack}.{csv,png}``: the per-node counts
-summed over every trial of that level, abstraction and guard mode. matplotlib is imported
+summed over every trial of that level, abstraction and guard mode (names made safe by
+:func:`headless.filenames.output_path`). matplotlib is imported
 lazily and drawn through ``Figure`` (no pyplot), so this works on headless machines.
 """
 
@@ -17,6 +18,7 @@ from typing import Any
 
 import numpy as np
 
+from .filenames import output_path
 from .tables import ABSTRACTION_NAMES, GUARD_NAMES
 from .tables import label as display
 
@@ -148,15 +150,15 @@ def write_heatmaps(sums: HeatSums, directory: Path, figures: bool = True) -> lis
             ("visit", heat.visits, "guard visits (sum)", "viridis"),
             ("attack", heat.attacks, "attack: HP lost (sum)", "inferno"),
         ):
-            stem = f"{level_name}_{abstraction}_{mode}_{kind}"
-            csv_path = out / f"{stem}.csv"
+            csv_path = output_path(out, level_name, abstraction, mode, kind, suffix=".csv")
             grid = _write_heatmap_csv(csv_path, graph, values, level.rows, level.cols)
             written.append(csv_path)
             if figures:
-                title = (f"{level_name} — {display(ABSTRACTION_NAMES, abstraction)} — {mode_name}: "
+                shown = "".join(c if c.isprintable() else "?" for c in level_name)
+                title = (f"{shown} — {display(ABSTRACTION_NAMES, abstraction)} — {mode_name}: "
                          f"{kind} heatmap\n(sum over {heat.trials} trials, all player policies "
                          "and scenarios)")
-                png = out / f"{stem}.png"
+                png = csv_path.with_suffix(".png")
                 _heatmap_png(png, level, graph, values, grid, title, label, cmap)
                 written.append(png)
     return written

@@ -49,6 +49,7 @@ from game.world import World
 from navmesh.graph import NodeGraph
 from navmesh.level import cached_level, load_level
 
+from .filenames import output_path
 from .stats import mean_or_nan, percentile_ci
 
 #: guards cannot see and the player cannot be hurt: only the mechanic informs the guards
@@ -504,16 +505,16 @@ def run_mechanics(
 def write_results(out: Path, rows: Sequence[Row], summaries: Sequence[Summary], table: str) -> None:
     """``mechanics.md``, ``mechanics.csv`` (one row per measure), ``mechanics_trials.csv``."""
     out.mkdir(parents=True, exist_ok=True)
-    (out / "mechanics.md").write_text("# Measured effects of the stealth mechanics\n\n" + table,
+    output_path(out, "mechanics", suffix=".md").write_text("# Measured effects of the stealth mechanics\n\n" + table,
                                       encoding="utf-8")
-    with (out / "mechanics.csv").open("w", newline="", encoding="utf-8") as handle:
+    with output_path(out, "mechanics", suffix=".csv").open("w", newline="", encoding="utf-8") as handle:
         writer = csv.writer(handle)
         writer.writerow(["measure", "n", "on", "on_lo", "on_hi", "control", "control_lo",
                          "control_hi", "diff", "diff_lo", "diff_hi", "intended", "as_intended"])
         for s in summaries:
             writer.writerow([s.measure, s.n, s.on, *s.on_ci, s.control, *s.control_ci, s.diff,
                              *s.diff_ci, "up" if s.expected > 0 else "down", s.verdict])
-    with (out / "mechanics_trials.csv").open("w", newline="", encoding="utf-8") as handle:
+    with output_path(out, "mechanics", "trials", suffix=".csv").open("w", newline="", encoding="utf-8") as handle:
         writer = csv.writer(handle)
         writer.writerow(["measure", "seed", "arm", "value"])
         writer.writerows(rows)

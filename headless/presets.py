@@ -172,6 +172,8 @@ def _names(data: Mapping[str, Any], key: str, src: str, allowed: Sequence[str] |
 
 
 def _seeds(data: Mapping[str, Any], src: str) -> tuple[int, ...]:
+    from game.schema import SEED
+
     if "seeds" not in data:
         raise _fail(src, "seeds", "missing required key (a count, or a list of seeds)")
     value = data["seeds"]
@@ -183,8 +185,9 @@ def _seeds(data: Mapping[str, Any], src: str) -> tuple[int, ...]:
     if isinstance(value, list):
         if not value:
             raise _fail(src, "seeds", "empty list: the design would have no trials")
-        if not all(isinstance(v, int) and not isinstance(v, bool) and v >= 0 for v in value):
-            raise _fail(src, "seeds", f"expected whole numbers >= 0, got {value!r}")
+        for seed in value:
+            if isinstance(seed, bool) or not isinstance(seed, int) or SEED.problem(seed):
+                raise _fail(src, "seeds", f"{seed!r}: a seed {SEED.problem(seed)}")
         if len(set(value)) != len(value):
             raise _fail(src, "seeds", "a seed is listed twice")
         return tuple(value)
@@ -215,6 +218,7 @@ def parse_preset(
     from ai import GUARD_MODES, PLAYER_POLICIES, guard_mode, player_policy
     from game.config import Config
     from game.errors import ConfigError
+    from game.schema import SEED, check_level
     from game.world import SCENARIOS
     from navmesh.errors import LevelError
     from navmesh.graph import ABSTRACTIONS, graph_for
@@ -232,8 +236,8 @@ def parse_preset(
     scenarios = _names(data, "scenarios", src, SCENARIOS)
     seeds = _seeds(data, src)
     root_seed = data.get("root_seed", 0)
-    if isinstance(root_seed, bool) or not isinstance(root_seed, int) or root_seed < 0:
-        raise _fail(src, "root_seed", f"expected a whole number >= 0, got {root_seed!r}")
+    if isinstance(root_seed, bool) or not isinstance(root_seed, int) or SEED.problem(root_seed):
+        raise _fail(src, "root_seed", f"{root_seed!r}: {SEED.problem(root_seed)}")
 
     overrides_table = data.get("set", {})
     if not isinstance(overrides_table, Mapping):
@@ -273,6 +277,10 @@ def parse_preset(
             raise _fail(src, "levels", str(error)) from None
         if level.name in names:
             raise _fail(src, "levels", f"two levels are named {level.name!r}")
+        try:
+            check_level(config, level)
+        except ConfigError as error:
+            raise _fail(src, "set", str(error)) from None
         for abstraction in abstractions:
             try:
                 graph_for(level, abstraction)

@@ -31,6 +31,7 @@ from game.trial import TrialSpec
 
 from .errors import SweepError, UserError
 from .executors import InlineExecutor, connect_dask, process_pool, run_batch, shutdown, terminate
+from .filenames import output_path
 from .presets import Preset, load_preset
 from .progress import Progress
 from .store import STORE_NAME, ResultStore
@@ -321,7 +322,7 @@ def cmd_run(args: argparse.Namespace) -> int:
     if args.workers is not None and args.workers < 1:
         raise UserError(f"--workers: must be at least 1, got {args.workers}")
     preset = load_preset(args.preset)
-    out = Path(args.out) if args.out else Path("results") / preset.name
+    out = Path(args.out) if args.out else output_path("results", preset.name)
     stderr = sys.stderr
     result = run_sweep(preset, out, workers=args.workers, scheduler=args.scheduler)
     if result.interrupted:

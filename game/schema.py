@@ -1,0 +1,167 @@
+"""The allowed values of every config key (``game/defaults.toml``), declared once each.
+
+A section that feeds a parameter dataclass takes that class's ``bounds``
+(:mod:`ai.bounds`): ``[pf]`` is :class:`~ai.params.PFParams`, ``[fsm]`` / ``[staleness]``
+the FSM classes, ``[player]`` :class:`~ai.params.PlayerParams`, ``[stimuli]``
+:class:`~ai.stimuli.StimulusParams` plus :class:`~game.actions.ActionParams`, ``[zones]``
+:class:`~ai.stimuli.Zone` per zone kind. The world's and the scenarios' keys, which no
+dataclass holds, are declared here. :func:`game.config.check_value` checks a value against
+:func:`bound_of` its key; :func:`check_sections` builds the dataclasses (their cross-key
+rules, e.g. ``w_I_max >= w_I_base``) and :func:`check_level` what depends on the level.
+``docs/config.md`` is :func:`markdown_table` (a test keeps it current).
+
+>>> bound_of("pf.rho").describe(), bound_of("world.fov_deg").describe()
+('(0, 1]', '[0, 360]')
+>>> bound_of("zones.dark_confidence_decay") is bound_of("zones.concealment_confidence_decay")
+True
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable, Mapping
+from typing import TYPE_CHECKING, Any
+
+from ai.bounds import COUNT, FLAG, NON_NEGATIVE, POSITIVE, Bound, OneOf, Range
+from ai.params import FSMParams, PFParams, PlayerParams, StalenessParams
+from ai.stimuli import StimulusParams, Zone, zones_from_config
+from navmesh.level import ZONE_KINDS
+
+from .actions import ActionParams
+from .errors import ConfigError
+
+if TYPE_CHECKING:
+    from navmesh.level import Level
+
+    from .config import Config
+
+__all__ = [
+    "SEED", "SPAWN_RULES", "bound_of", "check_level", "check_sections", "markdown_table",
+]
+
+SPAWN_RULES = ("random", "level")
+"""``world.spawns``: guard start nodes drawn per seed, or the level's spawn points."""
+
+SEED = Range(0, 2**63 - 1, integer=True)
+"""A trial's ``seed`` and a preset's ``root_seed``: whole numbers that fit the store's
+64-bit integer column (``numpy.random.SeedSequence`` refuses negative ones)."""
+
+#: SPEC §6: the physics step is at most 1/20 s (faster bodies would tunnel through walls)
+_PHYSICS_STEP = Range(0.0, 0.05, low_open=True)
+
+WORLD: Mapping[str, Bound] = {
+    "guards": COUNT,
+    "spawns": OneOf(SPAWN_RULES),
+    "player_hp": POSITIVE,
+    "ai_tick": POSITIVE,
+    "physics_step": _PHYSICS_STEP,
+    "physics_step_interactive": _PHYSICS_STEP,
+    "duration": POSITIVE,
+    # the scripted players read both speeds too: their declaration is the one
+    "guard_speed": PlayerParams.bounds["guard_speed"],
+    "player_speed": PlayerParams.bounds["player_speed"],
+    "sprint_factor": POSITIVE,
+    # and below half the level's cell size: check_level
+    "agent_radius": POSITIVE,
+    "view_range": NON_NEGATIVE,
+    "fov_deg": Range(0.0, 360.0),
+    "attack_range": NON_NEGATIVE,
+    "attack_needs_line_of_sight": FLAG,
+    "stuck_timeout": POSITIVE,
+}
+"""``[world]``: the keys the world reads itself."""
+
+SCENARIO: Mapping[str, Bound] = {
+    "player_speed_scale": POSITIVE,
+    "view_range_scale": NON_NEGATIVE,
+    "end_on_capture": FLAG,
+}
+"""``[scenario.<name>]``: the same keys for every scenario."""
+
+_PLAYER_OWN = {k: v for k, v in PlayerParams.bounds.items()
+               if k not in ("guard_speed", "player_speed")}  # those come from [world]
+
+_SECTIONS: Mapping[str, Mapping[str, Bound]] = {
+    "world": WORLD,
+    "zones": {f"{kind}_{name}": bound for kind in ZONE_KINDS for name, bound in Zone.bounds.items()},
+    "stimuli": {**StimulusParams.bounds, **ActionParams.bounds},
+    "pf": PFParams.bounds,
+    "fsm": FSMParams.bounds,
+    "staleness": StalenessParams.bounds,
+    "player": _PLAYER_OWN,
+}
+
+
+def bound_of(key: str) -> Bound:
+    """The declared allowed values of config key ``key``; KeyError when none is declared."""
+    section, _, name = key.rpartition(".")
+    table = SCENARIO if section.startswith("scenario.") else _SECTIONS.get(section, {})
+    if name not in table:
+        raise KeyError(f"{key}: no bound declared in game.schema")
+    return table[name]
+
+
+def _section(values: Mapping[str, Any], name: str) -> dict[str, Any]:
+    prefix = name + "."
+    return {k[len(prefix):]: v for k, v in values.items()
+            if k.startswith(prefix) and "." not in k[len(prefix):]}
+
+
+def check_sections(values: Mapping[str, Any]) -> None:
+    """Build every section's parameter dataclass from ``values`` (flat dotted keys), so the
+    rules between keys hold before anything runs; a violation raises :class:`ConfigError`.
+
+    ``values`` are already in range key by key (:func:`game.config.check_value`).
+    """
+    builds: list[tuple[str, Any, dict[str, Any]]] = [
+        ("pf", PFParams, _section(values, "pf")),
+        ("fsm", FSMParams, _section(values, "fsm")),
+        ("staleness", StalenessParams, _section(values, "staleness")),
+    ]
+    stimuli = _section(values, "stimuli")
+    actions = {k: v for k, v in stimuli.items() if k in ActionParams.bounds}
+    builds.append(("stimuli", ActionParams, actions))
+    builds.append(("stimuli", StimulusParams,
+                   {k: v for k, v in stimuli.items() if k not in actions}))
+    for scenario in sorted({k.split(".")[1] for k in values if k.startswith("scenario.")}):
+        player = _section(values, "player")
+        player["guard_speed"] = values["world.guard_speed"]
+        player["player_speed"] = (values["world.player_speed"]
+                                  * values[f"scenario.{scenario}.player_speed_scale"])
+        builds.append((f"player (scenario {scenario})", PlayerParams, player))
+    for where, cls, params in builds:
+        try:
+            cls.from_mapping(params)
+        except ValueError as error:
+            raise ConfigError(f"{where}: {error}") from None
+    try:
+        zones_from_config(_section(values, "zones"))
+    except ValueError as error:
+        raise ConfigError(f"zones: {error}") from None
+
+
+def check_level(config: Config, level: Level) -> None:
+    """What a level bounds: an agent's body must pass a one-cell corridor, so
+    ``world.agent_radius`` must be below half the level's cell size (both abstractions:
+    the level is drawn on that grid). Raises :class:`ConfigError`.
+    """
+    radius = float(config["world.agent_radius"])
+    half = level.cell_size / 2
+    if not radius < half:
+        raise ConfigError(
+            f"world.agent_radius = {radius:g}: must be below half the cell size of level "
+            f"{level.name!r} ({half:g}), or an agent cannot pass a one-cell corridor")
+
+
+def markdown_table(keys: Iterable[str]) -> str:
+    """The allowed values of ``keys`` as a Markdown table (``docs/config.md``)."""
+    lines = ["| key | allowed values |", "|---|---|"]
+    for key in keys:
+        bound = bound_of(key)
+        if isinstance(bound, Range):
+            text = ("whole number in " if bound.integer else "") + bound.describe()
+        else:
+            text = "one of " + bound.describe()
+        if key == "world.agent_radius":
+            text += ", and below half the level's cell size"
+        lines.append(f"| `{key}` | {text} |")
+    return "\n".join(lines) + "\n"
