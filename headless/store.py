@@ -192,7 +192,11 @@ class ResultStore:
             )
 
     def meta(self) -> dict[str, str]:
-        """Every ``meta`` value."""
+        """Every ``meta`` value (none in a file whose creation was killed before its tables)."""
+        if self.db.execute(
+            "SELECT 1 FROM sqlite_master WHERE type = 'table' AND name = 'meta'"
+        ).fetchone() is None:
+            return {}
         return {r[0]: r[1] for r in self.db.execute("SELECT key, value FROM meta")}
 
     # ------------------------------------------------------------------ trials

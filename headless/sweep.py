@@ -29,8 +29,17 @@ from typing import IO, Any
 
 from game.trial import TrialSpec
 
-from .errors import SweepError, UserError
-from .executors import InlineExecutor, connect_dask, process_pool, run_batch, shutdown, terminate
+from .dirlock import DirectoryLock
+from .errors import SweepError
+from .executors import (
+    InlineExecutor,
+    check_workers,
+    connect_dask,
+    process_pool,
+    run_batch,
+    shutdown,
+    terminate,
+)
 from .presets import Preset, load_preset
 from .progress import Progress
 from .store import STORE_NAME, ResultStore
@@ -97,23 +106,6 @@ def _check_store(store_path: Path, preset: Preset) -> None:
             "use another --out")
 
 
-def _lock(out: Path) -> Any:
-    """An exclusive lock on the results directory (one writing sweep at a time)."""
-    try:
-        import fcntl
-    except ImportError:  # pragma: no cover - not on POSIX: no lock
-        return None
-    handle = open(out / "results.lock", "w")
-    try:
-        fcntl.flock(handle, fcntl.LOCK_EX | fcntl.LOCK_NB)
-    except OSError:
-        handle.close()
-        raise SweepError(f"{out}: another sweep is writing to this directory") from None
-    handle.write(str(os.getpid()))
-    handle.flush()
-    return handle
-
-
 def run_sweep(
     preset: Preset,
     out: str | Path,
@@ -132,16 +124,14 @@ def run_sweep(
     """
     stream = stream if stream is not None else sys.stderr
     out = Path(out)
-    workers = workers or os.cpu_count() or 1
-    if workers < 1:
-        raise UserError(f"--workers: must be at least 1, got {workers}")
+    workers = check_workers(workers or os.cpu_count() or 1)
     if out.exists() and not out.is_dir():
         raise SweepError(f"--out {out}: exists and is not a directory")
     store_path = out / STORE_NAME
     _check_store(store_path, preset)
     client: Any = None
     executor: cf.Executor | None = None
-    lock: Any = None
+    lock: DirectoryLock | None = None
     store: ResultStore | None = None
     try:
         if scheduler:
@@ -154,7 +144,7 @@ def run_sweep(
             out.mkdir(parents=True, exist_ok=True)
         except OSError as error:
             raise SweepError(f"--out {out}: cannot create ({error.strerror or error})") from None
-        lock = _lock(out)
+        lock = DirectoryLock(out)
         if progress:
             stream.write(f"stealth: preset {preset.name}: {preset.n_trials} trials "
                          f"({len(preset.levels)} levels x {len(preset.abstractions)} "
@@ -318,8 +308,8 @@ def cmd_run(args: argparse.Namespace) -> int:
     written; raised as a :class:`~navmesh.errors.StealthError` for the CLI to print), 130
     interrupted (the store keeps every committed trial; rerun to resume).
     """
-    if args.workers is not None and args.workers < 1:
-        raise UserError(f"--workers: must be at least 1, got {args.workers}")
+    if args.workers is not None:
+        check_workers(args.workers)
     preset = load_preset(args.preset)
     out = Path(args.out) if args.out else Path("results") / preset.name
     stderr = sys.stderr
