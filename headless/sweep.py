@@ -84,8 +84,33 @@ def _batches(specs: Sequence[TrialSpec], size: int) -> Iterator[list[TrialSpec]]
         yield list(specs[i:i + size])
 
 
-def _check_store(store_path: Path, preset: Preset) -> None:
-    """Refuse to resume into a store that holds a different design or configuration."""
+def level_digests(preset: Preset) -> dict[str, str]:
+    """The SHA-256 of every level file of the design (``Level.digest``), by level reference."""
+    from navmesh.level import cached_level
+
+    return {ref: cached_level(ref).digest or "" for ref in preset.levels}
+
+
+def _check_levels(store_path: Path, stored: str | None, current: dict[str, str],
+                  preset: Preset) -> None:
+    """Refuse to resume when a level file changed since the store's trials ran on it.
+
+    A store from before level digests were kept has none: it resumes, and gets them.
+    """
+    if stored is None:
+        return
+    old = json.loads(stored)
+    names = dict(zip(preset.levels, preset.level_names))
+    for ref, digest in current.items():
+        if ref in old and old[ref] != digest:
+            raise SweepError(
+                f"{store_path}: level {names.get(ref, ref)!r} ({ref}) changed since its trials "
+                f"ran (sha256 {old[ref][:12]} then, {digest[:12]} now); restore the file or "
+                "use another --out")
+
+
+def _check_store(store_path: Path, preset: Preset, digests: dict[str, str]) -> None:
+    """Refuse to resume into a store that holds a different design, configuration or levels."""
     if not store_path.is_file():
         return
     try:
@@ -104,6 +129,7 @@ def _check_store(store_path: Path, preset: Preset) -> None:
             f"{store_path}: its trials ran with config {old_hash}, the current config is "
             f"{preset.config_hash} (game/defaults.toml or the preset's [set] changed); "
             "use another --out")
+    _check_levels(store_path, meta.get("level_digests"), digests, preset)
 
 
 def run_sweep(
@@ -128,7 +154,8 @@ def run_sweep(
     if out.exists() and not out.is_dir():
         raise SweepError(f"--out {out}: exists and is not a directory")
     store_path = out / STORE_NAME
-    _check_store(store_path, preset)
+    digests = level_digests(preset)
+    _check_store(store_path, preset, digests)
     client: Any = None
     executor: cf.Executor | None = None
     lock: DirectoryLock | None = None
@@ -158,6 +185,7 @@ def run_sweep(
             "preset_toml": preset.text, "design": json.dumps(preset.design()),
             "config_hash": preset.config_hash, "total_trials": str(preset.n_trials),
             "config": json.dumps(dict(preset.config), sort_keys=True),
+            "level_digests": json.dumps(digests, sort_keys=True),
             "updated_at": now,
         }
         if store.get_meta("created_at") is None:
