@@ -122,6 +122,8 @@ def _preset_path(name_or_path: str) -> tuple[Path, str]:
                         f"(bundled presets: {names})")
     if path.is_dir():
         raise PresetError(f"{name_or_path}: is a directory, not a preset file")
+    if path.exists():  # a FIFO, a device: load_preset's read refuses it with one line
+        return path, str(name_or_path)
     raise PresetError(f"{name_or_path}: no such preset file")
 
 
