@@ -17,6 +17,8 @@ from pathlib import Path
 import pytest
 
 from headless.cli import main
+from headless.errors import PresetError
+from headless.presets import load_preset
 from navmesh.errors import LevelError
 from navmesh.level import load_level, parse_level
 
@@ -101,15 +103,13 @@ def test_a_hundred_million_seeds_are_refused_before_any_allocation(tmp_path: Pat
     assert not (tmp_path / "out").exists()
 
 
-def test_a_design_with_too_many_trials_is_refused(tmp_path: Path,
-                                                  capsys: pytest.CaptureFixture[str]) -> None:
+def test_a_design_with_too_many_trials_is_refused(tmp_path: Path) -> None:
     preset = tmp_path / "wide.toml"
     preset.write_text('levels = ["maze", "miami"]\nabstractions = ["grid", "partition"]\n'
                       'guards = ["pf", "cheat", "random"]\nplayers = ["maxmin"]\n'
                       'scenarios = ["capture", "fixed"]\nseeds = 200000\n')
-    assert main(["run", "--preset", str(preset), "--out", str(tmp_path / "out")]) == 2
-    assert "4800000 trials" in _one_error_line(capsys.readouterr().err)
-    assert not (tmp_path / "out").exists()
+    with pytest.raises(PresetError, match="4800000 trials, more than the limit"):
+        load_preset(str(preset))
 
 
 def test_a_thousand_workers_are_refused_before_a_pool_starts(
