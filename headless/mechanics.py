@@ -531,6 +531,7 @@ def cmd_mechanics(args: argparse.Namespace) -> int:
     except ValueError as error:
         print(f"stealth: error: {error}", file=sys.stderr)
         return 2
+    Path(args.out).mkdir(parents=True, exist_ok=True)  # an OSError now, not after the trials
     rows, seconds = run_mechanics(args.seeds, args.level, args.abstraction, args.workers)
     table = markdown(summarise(rows), draw_curve(rows), level.name, args.abstraction,
                      args.seeds, seconds)
