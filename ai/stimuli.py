@@ -43,6 +43,7 @@ import numpy as np
 
 from navmesh.graph import UNREACHABLE_HOPS, NodeGraph
 
+from . import plugin_call
 from .errors import StimulusError
 from .bounds import COUNT, FLAG, FRACTION, NON_NEGATIVE, UNIT, Bound
 from .params import _Params
@@ -161,7 +162,10 @@ class FieldContext:
         sound = base or Sound(self.params.noise_amplitude, self.params.noise_falloff)
         for stimulus in self.active:
             if not stimulus.done:
-                sound = stimulus.affect_sound(sound)
+                sound = plugin_call.call(stimulus, stimulus.affect_sound, sound)
+                if not isinstance(sound, Sound):
+                    raise StimulusError(f"{plugin_call.describe(stimulus)}: affect_sound() "
+                                        f"returned {type(sound).__name__}, not a Sound")
         return sound
 
     def node_at(self, x: float, y: float) -> int:
@@ -514,7 +518,7 @@ class StimulusSet:
         """Start ``stimulus`` in this trial and return it."""
         if not isinstance(stimulus, Stimulus):
             raise TypeError(f"expected a Stimulus, got {type(stimulus).__name__}")
-        stimulus.start(self.ctx)
+        plugin_call.call(stimulus, stimulus.start, self.ctx)
         self._active.append(stimulus)
         self.ctx.active = tuple(self._active)
         return stimulus
@@ -522,7 +526,7 @@ class StimulusSet:
     def handle(self, event: Event) -> list[Stimulus]:
         """Dispatch one event: to the active stimuli, then to its kind's rule."""
         for stimulus in self._active:
-            stimulus.on_event(event)
+            plugin_call.call(stimulus, stimulus.on_event, event)
         rule = self.rules.get(event.kind)
         if rule is None:
             return []
@@ -536,11 +540,11 @@ class StimulusSet:
         """One AI tick: decay, events, ``on_tick``, removal, hooks (see the class docstring)."""
         self.ctx.t = float(view.t)
         for stimulus in self._active:
-            stimulus.decay(dt)
+            plugin_call.call(stimulus, stimulus.decay, dt)
         for event in view.events:
             self.handle(event)
         for stimulus in self._active:
-            stimulus.on_tick(view, dt)
+            plugin_call.call(stimulus, stimulus.on_tick, view, dt)
         self._active = [s for s in self._active if not s.done]
         self.ctx.active = tuple(self._active)
         self.refresh()
@@ -550,22 +554,20 @@ class StimulusSet:
         """The sum of the active stimuli's layers (n,)."""
         total = np.zeros(self.ctx.n)
         for stimulus in self._active:
-            values = stimulus.inject(self.ctx)
-            if values is None:
-                continue
-            values = np.asarray(values, dtype=np.float64)
-            if values.shape != total.shape:
-                raise ValueError(
-                    f"stimulus {stimulus.name!r}: inject() must return shape {total.shape}, "
-                    f"got {values.shape}"
-                )
-            total += values
+            values = plugin_call.checked_layer(
+                stimulus, plugin_call.call(stimulus, stimulus.inject, self.ctx), self.ctx.n)
+            if values is not None:
+                total += values
         return total
 
     def weight_floor(self) -> float:
         """The largest information-weight floor the active stimuli ask for (0: none)."""
-        floors = [s.information_weight_floor for s in self._active]
-        return max((float(f) for f in floors if f is not None), default=0.0)
+        floors = [
+            plugin_call.checked_number(s, "information_weight_floor",
+                                       s.information_weight_floor, 0.0, 1.0)
+            for s in self._active if s.information_weight_floor is not None
+        ]
+        return max(floors, default=0.0)
 
     def refresh(self) -> None:
         """Assign the layer sum and the weight floor to the guard AI's hooks, if it has them."""

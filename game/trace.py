@@ -2,7 +2,10 @@
 
 A trace line holds ``t``, ``player {pos, hp, node}``, ``guards [{pos, heading,
 sees_player, node, target, state, active}]``, ``events`` and, when stimuli are active,
-``stimuli [{name, node, ...}]``. :func:`trace_record` builds a line from a
+``stimuli [{name, node, ...}]``. The first line also names the trial's level (``level``:
+a bundled name or the file's absolute path, ``level_digest``: the SHA-256 of its file) and
+``abstraction``, so a replay on another level is refused; the last line is the final state
+(marked ``"final": true`` when the trial ended between two AI ticks). :func:`trace_record` builds a line from a
 :class:`~game.world.World`, :func:`attach_trace` writes one per AI tick to a file, and
 :func:`load_trace` reads and validates a file (every problem is a one-line
 :class:`TraceError`).
@@ -16,8 +19,16 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import IO, TYPE_CHECKING, Any
 
+from ai.plugin_call import call
+from navmesh.files import FileRefused, read_regular
+from navmesh.level import LEVELS_DIR, Level
+
 if TYPE_CHECKING:
     from .world import World
+
+
+MAX_TRACE_BYTES = 256 * 2**20
+"""Largest trace file read (256 MiB; a 60-s trial's trace is tens of kB)."""
 
 
 def _round(value: float | None) -> float | None:
@@ -49,24 +60,55 @@ def trace_record(world: World) -> dict[str, Any]:
             {"kind": e.kind, "node": e.node, "t": _round(e.t), **dict(e.data)}
             for e in world.tick_events
         ],
-        **({"stimuli": [s.describe() for s in world.stimuli.active]} if world.stimuli else {}),
+        **({"stimuli": [call(s, s.describe) for s in world.stimuli.active]}
+           if world.stimuli else {}),
     }
 
 
-def attach_trace(world: World, handle: IO[str], *, explain: bool = False) -> None:
-    """Write ``world``'s line now (t = 0) and after every AI tick to ``handle``.
+def level_ref(level: Level) -> str:
+    """How a trace names its level: a bundled level by its name, a file by its absolute path."""
+    if level.path is None:
+        return level.name
+    path = level.path.resolve()
+    if path.parent == LEVELS_DIR.resolve():
+        return path.stem
+    return str(path)
+
+
+class TraceWriter:
+    """Writes a trial's trace: its first line names the level (``level``, ``level_digest``,
+    ``abstraction``), then one line per AI tick, and :meth:`finish` adds the final state
+    (the trial can end between AI ticks, e.g. at a capture at 57.8 s)."""
+
+    def __init__(self, world: World, handle: IO[str], *, explain: bool = False) -> None:
+        self.handle, self.explain = handle, explain
+        self.last_t: float | None = None
+        header = {"level": level_ref(world.level), "level_digest": world.level.digest,
+                  "abstraction": world.abstraction}
+        self.write(world, header)
+        world.on_tick = self.write
+
+    def write(self, world: World, extra: dict[str, Any] | None = None) -> None:
+        """Write ``world``'s line now."""
+        record = {**(extra or {}), **world.trace_record()}
+        if self.explain:
+            record["explain"] = world.guard_ai.explain(0)
+        self.handle.write(json.dumps(record) + "\n")
+        self.last_t = record["t"]
+
+    def finish(self, world: World) -> None:
+        """Write the final state, unless the last AI tick already wrote this moment."""
+        if self.last_t is None or _round(world.t) != self.last_t:
+            self.write(world, {"final": True})
+
+
+def attach_trace(world: World, handle: IO[str], *, explain: bool = False) -> TraceWriter:
+    """Write ``world``'s line now (t = 0) and after every AI tick to ``handle``; call the
+    result's :meth:`~TraceWriter.finish` when the trial has ended.
 
     With ``explain`` each line also carries the first guard's last decision explained.
     """
-
-    def write(w: World) -> None:
-        record = w.trace_record()
-        if explain:
-            record["explain"] = w.guard_ai.explain(0)
-        handle.write(json.dumps(record) + "\n")
-
-    write(world)
-    world.on_tick = write
+    return TraceWriter(world, handle, explain=explain)
 
 
 class TraceError(ValueError):
@@ -108,6 +150,8 @@ class Trace:
     lines: tuple[TraceLine, ...]
     level: str | None = None
     abstraction: str | None = None
+    #: SHA-256 of the level file the trace was recorded on (``Level.digest``), if it says
+    level_digest: str | None = None
 
 
 # ---------------------------------------------------------------------------- parsing
@@ -197,7 +241,9 @@ def load_trace(path: str | Path) -> Trace:
     """Read and validate a trace file; every problem is a one-line :class:`TraceError`."""
     name = str(path)
     try:
-        text = Path(path).read_text(encoding="utf-8")
+        text = read_regular(path, MAX_TRACE_BYTES).decode("utf-8")
+    except FileRefused as refused:
+        raise TraceError(f"{name}: {refused}") from None
     except FileNotFoundError:
         raise TraceError(f"{name}: no such file") from None
     except IsADirectoryError:
@@ -207,7 +253,7 @@ def load_trace(path: str | Path) -> Trace:
     except OSError as error:
         raise TraceError(f"{name}: cannot read ({error.strerror or error})") from None
     lines: list[TraceLine] = []
-    level = abstraction = None
+    level = abstraction = digest = None
     for number, raw in enumerate(text.splitlines(), start=1):
         if not raw.strip():
             continue
@@ -223,6 +269,8 @@ def load_trace(path: str | Path) -> Trace:
             level = record["level"]
         if record.get("abstraction") in ("grid", "partition"):
             abstraction = record["abstraction"]
+        if isinstance(record.get("level_digest"), str):
+            digest = record["level_digest"]
         if lines:
             if len(line.guards) != len(lines[0].guards):
                 raise TraceError(f"{where}: guards: {len(line.guards)} guards, but the first "
@@ -232,8 +280,8 @@ def load_trace(path: str | Path) -> Trace:
         lines.append(line)
     if not lines:
         raise TraceError(f"{name}: empty trace (no JSON lines)")
-    return Trace(name, tuple(lines), level, abstraction)
+    return Trace(name, tuple(lines), level, abstraction, digest)
 
 
-__all__ = ["GuardRecord", "Trace", "TraceError", "TraceLine", "attach_trace", "load_trace",
-           "parse_line", "trace_record"]
+__all__ = ["GuardRecord", "Trace", "TraceError", "TraceLine", "TraceWriter", "attach_trace",
+           "level_ref", "load_trace", "parse_line", "trace_record"]

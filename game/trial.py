@@ -114,9 +114,10 @@ def run_trial(
     config = Config.load(dict(spec.overrides))
     started = time.perf_counter()
     world = make_world(spec, config)
-    if trace is not None:
-        attach_trace(world, trace, explain=explain)
+    writer = attach_trace(world, trace, explain=explain) if trace is not None else None
     metrics = world.run()
+    if writer is not None:
+        writer.finish(world)
     return {
         **{k: v for k, v in asdict(spec).items() if k not in ("overrides", "stimuli")},
         **({"stimuli": list(spec.stimuli)} if spec.stimuli else {}),

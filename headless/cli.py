@@ -11,8 +11,13 @@ stderr. The heavy commands live in their own modules and are imported only when 
 from __future__ import annotations
 
 import argparse
+import errno
+import io
 import json
+import os
+import sqlite3
 import sys
+import traceback
 from collections.abc import Sequence
 from typing import Any, NoReturn
 
@@ -174,12 +179,21 @@ def cmd_sim(args: argparse.Namespace) -> int:
         stimuli=tuple(args.stimulus),
     )
     if args.trace:
+        from navmesh.level import resolve_level_path
+
+        from .clobber import refuse_inputs
+
+        plugins = [p.rpartition(":")[0] for p in args.stimulus if ":" in p]
+        refuse_inputs("--trace", args.trace, [resolve_level_path(args.level), *plugins])
         try:
             handle = open(args.trace, "w", encoding="utf-8")
         except OSError as error:
             raise UserError(f"--trace {args.trace}: cannot write ({error.strerror})") from None
-        with handle:
-            row = run_trial(spec, trace=handle, explain=args.explain)
+        try:
+            with handle:
+                row = run_trial(spec, trace=handle, explain=args.explain)
+        except OSError as error:  # the disk filled up, the device refused: name the file
+            raise OSError(error.errno, error.strerror, args.trace) from error
     elif args.explain:
         row = run_trial(spec, trace=sys.stderr, explain=True)
     else:
@@ -288,11 +302,15 @@ def build_parser() -> argparse.ArgumentParser:
         formatter_class=_Help,
     )
     parser.add_argument("--version", action="version", version=f"stealth {_version()}")
+    parser.add_argument("--debug", action="store_true",
+                        help="on an error, print the traceback before the one-line message")
     sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
 
     def command(name: str, text: str, **kwargs: Any) -> argparse.ArgumentParser:
-        return sub.add_parser(name, help=text, description=text, formatter_class=_Help,
-                              **kwargs)
+        p = sub.add_parser(name, help=text, description=text, formatter_class=_Help, **kwargs)
+        p.add_argument("--debug", action="store_true",
+                       help="on an error, print the traceback before the one-line message")
+        return p
 
     def add_json(p: argparse.ArgumentParser) -> None:
         p.add_argument("--json", action="store_true",
@@ -412,16 +430,71 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    """Run one ``stealth`` command; returns its exit code (2 for any user error)."""
+    """Run one ``stealth`` command; returns its exit code (2 for any user error).
+
+    The one place where failures become one line: a :class:`StealthError` (a user's
+    mistake), an :class:`OSError` (disk full, read-only or missing directory, a directory
+    where a file should be, a closed pipe: :func:`os_error_line` names the file and the
+    errno) or a results store SQLite cannot write. ``--debug`` anywhere before ``--`` also
+    prints the traceback.
+    """
+    words = list(sys.argv[1:] if argv is None else argv)
+    debug = "--debug" in words[:words.index("--")] if "--" in words else "--debug" in words
+    _tolerant_streams()
     try:
-        args = build_parser().parse_args(argv)
+        args = build_parser().parse_args(words)
         return int(args.func(args))
     except StealthError as error:
-        print(f"stealth: error: {' '.join(str(error).split())}", file=sys.stderr)
-        return EXIT_USER_ERROR
+        return _fail(str(error), debug)
+    except BrokenPipeError:
+        _detach_stdout()  # the reader is gone: nothing more can reach it
+        return _fail("stdout: the reading end of the pipe was closed (EPIPE)", debug)
+    except OSError as error:
+        return _fail(os_error_line(error), debug)
+    except sqlite3.DatabaseError as error:
+        return _fail(f"results store: {error}", debug)
     except KeyboardInterrupt:
         print("stealth: interrupted", file=sys.stderr)
         return 130
+
+
+def os_error_line(error: OSError) -> str:
+    """``FILE: what happened (ERRNO)`` for an OSError, e.g. ``/dev/full: No space left on
+    device (ENOSPC)``.
+
+    >>> os_error_line(IsADirectoryError(21, "Is a directory", "out/table.md"))
+    'out/table.md: Is a directory (EISDIR)'
+    """
+    code = errno.errorcode.get(error.errno or 0)
+    text = error.strerror or str(error) or type(error).__name__
+    names = [str(f) for f in (error.filename, error.filename2) if f is not None]
+    return (f"{' -> '.join(names)}: " if names else "") + text + (f" ({code})" if code else "")
+
+
+def _fail(message: str, debug: bool) -> int:
+    """Print the one ``stealth: error:`` line (after the traceback with ``--debug``)."""
+    if debug:
+        traceback.print_exc(file=sys.stderr)
+    print(f"stealth: error: {' '.join(message.split())}", file=sys.stderr)
+    return EXIT_USER_ERROR
+
+
+def _tolerant_streams() -> None:
+    """Under an ASCII locale a level or file name that ASCII cannot spell is printed with
+    backslash escapes instead of ending the command with a UnicodeEncodeError."""
+    for stream in (sys.stdout, sys.stderr):
+        if isinstance(stream, io.TextIOWrapper):
+            stream.reconfigure(errors="backslashreplace")
+
+
+def _detach_stdout() -> None:
+    """Point stdout at /dev/null, so the interpreter's final flush cannot fail again."""
+    try:
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, sys.stdout.fileno())
+        os.close(devnull)
+    except (OSError, ValueError):
+        pass
 
 
 if __name__ == "__main__":

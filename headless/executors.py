@@ -11,18 +11,22 @@ executor from a function here and pick it in :func:`headless.sweep.run_sweep`.
 from __future__ import annotations
 
 import concurrent.futures as cf
+import os
 import signal
+import sys
+import threading
+import time
 import traceback
 from collections.abc import Callable, Sequence
 from typing import Any
 
 from game.trial import TrialSpec, run_trial
 
-from .errors import SweepError
+from .errors import SweepError, UserError
 
 __all__ = [
-    "InlineExecutor", "connect_dask", "process_pool", "run_batch", "run_one", "shutdown",
-    "terminate",
+    "MAX_WORKERS_PER_CPU", "InlineExecutor", "check_workers", "connect_dask", "process_pool",
+    "run_batch", "run_one", "shutdown", "terminate",
 ]
 
 
@@ -59,14 +63,62 @@ class InlineExecutor(cf.Executor):
         return future
 
 
-def _ignore_sigint() -> None:
-    """Pool worker initializer: Ctrl-C is the main process's business."""
+MAX_WORKERS_PER_CPU = 4
+"""``--workers`` may ask for at most this many processes per CPU."""
+
+
+def check_workers(workers: int) -> int:
+    """``workers`` if it is a sensible number of local processes, else a one-line UserError.
+
+    >>> check_workers(1)
+    1
+    """
+    limit = MAX_WORKERS_PER_CPU * (os.cpu_count() or 1)
+    if workers < 1:
+        raise UserError(f"--workers: must be at least 1, got {workers}")
+    if workers > limit:
+        raise UserError(f"--workers: {workers} is more than {MAX_WORKERS_PER_CPU} per CPU "
+                        f"({os.cpu_count() or 1} CPUs here, at most {limit})")
+    return workers
+
+
+def _die_with(parent: int) -> None:
+    """Pool worker initializer: Ctrl-C is the main process's business, and the worker ends
+    when its parent does (killed or not), so no orphan keeps running trials or files open.
+
+    On Linux the kernel sends SIGKILL at the parent's death (``prctl(PR_SET_PDEATHSIG)``);
+    everywhere a daemon thread also polls :func:`os.getppid` and exits once the worker has
+    been re-parented.
+    """
     signal.signal(signal.SIGINT, signal.SIG_IGN)
+    if sys.platform.startswith("linux"):
+        try:
+            import ctypes
+
+            libc = ctypes.CDLL(None, use_errno=True)
+            libc.prctl(_PR_SET_PDEATHSIG, int(signal.SIGKILL), 0, 0, 0)
+        except (OSError, AttributeError):  # pragma: no cover - no usable libc: the watchdog
+            pass
+    if os.getppid() != parent:  # the parent died before the death signal was armed
+        os._exit(1)
+    threading.Thread(target=_watch_parent, args=(parent,), name="parent-watchdog",
+                     daemon=True).start()
+
+
+_PR_SET_PDEATHSIG = 1  # <linux/prctl.h>
+
+
+def _watch_parent(parent: int, interval: float = 0.5) -> None:
+    """End this process as soon as ``parent`` is no longer its parent."""
+    while os.getppid() == parent:
+        time.sleep(interval)
+    os._exit(1)
 
 
 def process_pool(workers: int) -> cf.ProcessPoolExecutor:
-    """A pool of ``workers`` processes that leave Ctrl-C to the main process."""
-    return cf.ProcessPoolExecutor(max_workers=workers, initializer=_ignore_sigint)
+    """A pool of ``workers`` processes that leave Ctrl-C to the main process and die with it."""
+    return cf.ProcessPoolExecutor(max_workers=check_workers(workers), initializer=_die_with,
+                                  initargs=(os.getpid(),))
 
 
 def connect_dask(scheduler: str) -> tuple[Any, cf.Executor, int]:

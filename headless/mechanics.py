@@ -27,7 +27,6 @@ seed and measure, both arms).
 from __future__ import annotations
 
 import argparse
-import concurrent.futures as cf
 import csv
 import math
 import os
@@ -49,6 +48,7 @@ from game.world import World
 from navmesh.graph import NodeGraph
 from navmesh.level import cached_level, load_level
 
+from .executors import check_workers, process_pool
 from .filenames import output_path
 from .stats import mean_or_nan, percentile_ci
 
@@ -493,7 +493,7 @@ def run_mechanics(
         for k, job in enumerate(jobs, 1):
             collect(run_job(job), k)
     else:
-        with cf.ProcessPoolExecutor(max_workers=workers) as pool:
+        with process_pool(workers) as pool:
             for k, result in enumerate(pool.map(run_job, jobs, chunksize=2), 1):
                 collect(result, k)
     if progress:
@@ -525,14 +525,14 @@ def cmd_mechanics(args: argparse.Namespace) -> int:
     if args.seeds < 2:
         print("stealth: error: --seeds: need at least 2 seeds", file=sys.stderr)
         return 2
-    if args.workers is not None and args.workers < 1:
-        print(f"stealth: error: --workers: must be at least 1, got {args.workers}", file=sys.stderr)
-        return 2
+    if args.workers is not None:
+        check_workers(args.workers)
     try:
         level = load_level(args.level)
     except ValueError as error:
         print(f"stealth: error: {error}", file=sys.stderr)
         return 2
+    Path(args.out).mkdir(parents=True, exist_ok=True)  # an OSError now, not after the trials
     rows, seconds = run_mechanics(args.seeds, args.level, args.abstraction, args.workers)
     table = markdown(summarise(rows), draw_curve(rows), level.name, args.abstraction,
                      args.seeds, seconds)

@@ -13,6 +13,7 @@ one-line ``description``. :func:`load_preset` turns one into a :class:`Preset` w
 
 from __future__ import annotations
 
+import math
 import tomllib
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
@@ -20,16 +21,23 @@ from pathlib import Path
 from typing import Any
 
 from game.trial import TrialSpec
+from navmesh.files import FileRefused, read_regular
 
 from .errors import PresetError
 
 __all__ = [
-    "PRESETS_DIR", "Preset", "bundled_preset_names", "bundled_presets", "load_preset",
+    "MAX_PRESET_BYTES", "MAX_TRIALS", "PRESETS_DIR", "Preset", "bundled_preset_names", "bundled_presets", "load_preset",
     "parse_preset",
 ]
 
 PRESETS_DIR = Path(__file__).resolve().parent / "presets"
 """Folder of the bundled presets."""
+
+MAX_TRIALS = 1_000_000
+"""Most trials one design may have (100 x the paper preset; about 8 h on 2 cores)."""
+
+MAX_PRESET_BYTES = 2**20
+"""Largest preset file read (1 MiB)."""
 
 _LIST_FIELDS = ("levels", "abstractions", "guards", "players", "scenarios")
 _ALLOWED_KEYS = (*_LIST_FIELDS, "seeds", "root_seed", "set", "description")
@@ -114,6 +122,8 @@ def _preset_path(name_or_path: str) -> tuple[Path, str]:
                         f"(bundled presets: {names})")
     if path.is_dir():
         raise PresetError(f"{name_or_path}: is a directory, not a preset file")
+    if path.exists():  # a FIFO, a device: load_preset's read refuses it with one line
+        return path, str(name_or_path)
     raise PresetError(f"{name_or_path}: no such preset file")
 
 
@@ -126,7 +136,9 @@ def load_preset(name_or_path: str) -> Preset:
     """
     path, src = _preset_path(name_or_path)
     try:
-        text = path.read_text(encoding="utf-8")
+        text = read_regular(path, MAX_PRESET_BYTES).decode("utf-8")
+    except FileRefused as refused:
+        raise PresetError(f"{src}: file: {refused}") from None
     except (OSError, UnicodeDecodeError) as error:
         raise PresetError(f"{src}: file: cannot read ({error})") from None
     try:
@@ -181,6 +193,9 @@ def _seeds(data: Mapping[str, Any], src: str) -> tuple[int, ...]:
         if value <= 0:
             raise _fail(src, "seeds", f"must be at least 1, got {value}: the design would "
                                       "have no trials")
+        if value > MAX_TRIALS:
+            raise _fail(src, "seeds", f"{value} seeds: more than the limit of {MAX_TRIALS} "
+                                      "trials of a design")
         return tuple(range(value))
     if isinstance(value, list):
         if not value:
@@ -235,6 +250,13 @@ def parse_preset(
     players = _names(data, "players", src, list(PLAYER_POLICIES))
     scenarios = _names(data, "scenarios", src, SCENARIOS)
     seeds = _seeds(data, src)
+    levels_raw = data.get("levels")
+    n_levels = len(levels_raw) if isinstance(levels_raw, list) else 1
+    n_trials = len(seeds) * n_levels * math.prod(
+        len(x) for x in (abstractions, guards, players, scenarios))
+    if n_trials > MAX_TRIALS:
+        raise _fail(src, "seeds", f"the design has {n_trials} trials, more than the limit of "
+                                  f"{MAX_TRIALS}; use fewer seeds or split it into presets")
     root_seed = data.get("root_seed", 0)
     if isinstance(root_seed, bool) or not isinstance(root_seed, int) or SEED.problem(root_seed):
         raise _fail(src, "root_seed", f"{root_seed!r}: {SEED.problem(root_seed)}")

@@ -7,9 +7,10 @@
   opening an older store adds the columns of metrics registered since), the per-node ``visits`` and
   ``attacks`` lists (zlib-compressed JSON, ``json.loads(zlib.decompress(blob))``), the error
   text (``NULL`` on success), the wall time and when it finished;
-* ``meta`` — key/value text: the preset (its TOML text and its expanded design as JSON) and
-  the config hash, so ``stealth report`` knows the design and a resumed sweep can check
-  that it continues the same experiment.
+* ``meta`` — key/value text: the preset (its TOML text and its expanded design as JSON),
+  the config hash and ``level_digests`` (the SHA-256 of every level file, by level
+  reference), so ``stealth report`` knows the design and a resumed sweep can check that it
+  continues the same experiment on the same geometry.
 
 Every finished trial is committed at once, so a sweep killed at any moment loses at most
 the trials still running. Only the sweep's main process writes; readers (``stealth
@@ -192,7 +193,11 @@ class ResultStore:
             )
 
     def meta(self) -> dict[str, str]:
-        """Every ``meta`` value."""
+        """Every ``meta`` value (none in a file whose creation was killed before its tables)."""
+        if self.db.execute(
+            "SELECT 1 FROM sqlite_master WHERE type = 'table' AND name = 'meta'"
+        ).fetchone() is None:
+            return {}
         return {r[0]: r[1] for r in self.db.execute("SELECT key, value FROM meta")}
 
     # ------------------------------------------------------------------ trials

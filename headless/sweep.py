@@ -29,8 +29,17 @@ from typing import IO, Any
 
 from game.trial import TrialSpec
 
-from .errors import SweepError, UserError
-from .executors import InlineExecutor, connect_dask, process_pool, run_batch, shutdown, terminate
+from .dirlock import DirectoryLock
+from .errors import SweepError
+from .executors import (
+    InlineExecutor,
+    check_workers,
+    connect_dask,
+    process_pool,
+    run_batch,
+    shutdown,
+    terminate,
+)
 from .filenames import output_path
 from .presets import Preset, load_preset
 from .progress import Progress
@@ -76,8 +85,33 @@ def _batches(specs: Sequence[TrialSpec], size: int) -> Iterator[list[TrialSpec]]
         yield list(specs[i:i + size])
 
 
-def _check_store(store_path: Path, preset: Preset) -> None:
-    """Refuse to resume into a store that holds a different design or configuration."""
+def level_digests(preset: Preset) -> dict[str, str]:
+    """The SHA-256 of every level file of the design (``Level.digest``), by level reference."""
+    from navmesh.level import cached_level
+
+    return {ref: cached_level(ref).digest or "" for ref in preset.levels}
+
+
+def _check_levels(store_path: Path, stored: str | None, current: dict[str, str],
+                  preset: Preset) -> None:
+    """Refuse to resume when a level file changed since the store's trials ran on it.
+
+    A store from before level digests were kept has none: it resumes, and gets them.
+    """
+    if stored is None:
+        return
+    old = json.loads(stored)
+    names = dict(zip(preset.levels, preset.level_names))
+    for ref, digest in current.items():
+        if ref in old and old[ref] != digest:
+            raise SweepError(
+                f"{store_path}: level {names.get(ref, ref)!r} ({ref}) changed since its trials "
+                f"ran (sha256 {old[ref][:12]} then, {digest[:12]} now); restore the file or "
+                "use another --out")
+
+
+def _check_store(store_path: Path, preset: Preset, digests: dict[str, str]) -> None:
+    """Refuse to resume into a store that holds a different design, configuration or levels."""
     if not store_path.is_file():
         return
     try:
@@ -96,23 +130,7 @@ def _check_store(store_path: Path, preset: Preset) -> None:
             f"{store_path}: its trials ran with config {old_hash}, the current config is "
             f"{preset.config_hash} (game/defaults.toml or the preset's [set] changed); "
             "use another --out")
-
-
-def _lock(out: Path) -> Any:
-    """An exclusive lock on the results directory (one writing sweep at a time)."""
-    try:
-        import fcntl
-    except ImportError:  # pragma: no cover - not on POSIX: no lock
-        return None
-    handle = open(out / "results.lock", "w")
-    try:
-        fcntl.flock(handle, fcntl.LOCK_EX | fcntl.LOCK_NB)
-    except OSError:
-        handle.close()
-        raise SweepError(f"{out}: another sweep is writing to this directory") from None
-    handle.write(str(os.getpid()))
-    handle.flush()
-    return handle
+    _check_levels(store_path, meta.get("level_digests"), digests, preset)
 
 
 def run_sweep(
@@ -133,16 +151,15 @@ def run_sweep(
     """
     stream = stream if stream is not None else sys.stderr
     out = Path(out)
-    workers = workers or os.cpu_count() or 1
-    if workers < 1:
-        raise UserError(f"--workers: must be at least 1, got {workers}")
+    workers = check_workers(workers or os.cpu_count() or 1)
     if out.exists() and not out.is_dir():
         raise SweepError(f"--out {out}: exists and is not a directory")
     store_path = out / STORE_NAME
-    _check_store(store_path, preset)
+    digests = level_digests(preset)
+    _check_store(store_path, preset, digests)
     client: Any = None
     executor: cf.Executor | None = None
-    lock: Any = None
+    lock: DirectoryLock | None = None
     store: ResultStore | None = None
     try:
         if scheduler:
@@ -155,7 +172,7 @@ def run_sweep(
             out.mkdir(parents=True, exist_ok=True)
         except OSError as error:
             raise SweepError(f"--out {out}: cannot create ({error.strerror or error})") from None
-        lock = _lock(out)
+        lock = DirectoryLock(out)
         if progress:
             stream.write(f"stealth: preset {preset.name}: {preset.n_trials} trials "
                          f"({len(preset.levels)} levels x {len(preset.abstractions)} "
@@ -169,6 +186,7 @@ def run_sweep(
             "preset_toml": preset.text, "design": json.dumps(preset.design()),
             "config_hash": preset.config_hash, "total_trials": str(preset.n_trials),
             "config": json.dumps(dict(preset.config), sort_keys=True),
+            "level_digests": json.dumps(digests, sort_keys=True),
             "updated_at": now,
         }
         if store.get_meta("created_at") is None:
@@ -319,8 +337,8 @@ def cmd_run(args: argparse.Namespace) -> int:
     written; raised as a :class:`~navmesh.errors.StealthError` for the CLI to print), 130
     interrupted (the store keeps every committed trial; rerun to resume).
     """
-    if args.workers is not None and args.workers < 1:
-        raise UserError(f"--workers: must be at least 1, got {args.workers}")
+    if args.workers is not None:
+        check_workers(args.workers)
     preset = load_preset(args.preset)
     out = Path(args.out) if args.out else output_path("results", preset.name)
     stderr = sys.stderr

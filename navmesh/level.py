@@ -36,9 +36,12 @@ from shapely.geometry.base import BaseGeometry
 from shapely.geometry.polygon import orient
 
 from navmesh.errors import LevelError
+from navmesh.files import FileRefused, read_regular
 
 __all__ = [
     "FORMAT",
+    "MAX_FILE_BYTES",
+    "MAX_SPOTS",
     "LEVELS_DIR",
     "MAX_CELLS",
     "ZONE_KINDS",
@@ -58,6 +61,12 @@ FORMAT = "stealth-level/1"
 
 MAX_CELLS = 1_000_000
 """Largest allowed occupancy grid (rows x cols); checked before anything is rasterised."""
+
+MAX_FILE_BYTES = 64 * 2**20
+"""Largest level file read (64 MiB; the bundled levels are a few kB)."""
+
+MAX_SPOTS = 1000
+"""Most guard, decoy or collectible points a level may list (each is a body in the world)."""
 
 ZONE_KINDS = ("dark", "concealment")
 """The built-in zone kinds; a stimulus may declare more with :func:`register_zone_kind`."""
@@ -365,9 +374,12 @@ _cached_parse = lru_cache(maxsize=32)(_parse_content)
 
 
 def _read_bytes(path: Path, src: str) -> bytes:
-    """Read a level file; every failure becomes a one-line LevelError."""
+    """Read a level file (a regular file of at most :data:`MAX_FILE_BYTES`); every failure
+    becomes a one-line LevelError."""
     try:
-        return path.read_bytes()
+        return read_regular(path, MAX_FILE_BYTES)
+    except FileRefused as refused:
+        _fail(src, "file", str(refused))
     except FileNotFoundError:
         _fail(src, "file", "no such file")
     except IsADirectoryError:
@@ -709,6 +721,8 @@ def _parse_spots(
         _fail(src, field, f"expected an array of [x, y] points, got {_describe(value)}")
     if required and not value:
         _fail(src, field, "needs at least one point")
+    if len(value) > MAX_SPOTS:
+        _fail(src, field, f"{len(value)} points, more than the limit of {MAX_SPOTS}")
     points = tuple(_point(p, src, f"{field}[{i}]") for i, p in enumerate(value))
     level = dict(walkable=walkable, occupancy=occupancy, outline=outline, cell_size=cell_size)
     for i, point in enumerate(points):

@@ -400,7 +400,13 @@ def test_broken_traces_are_one_line_errors(tmp_path: Path, capsys, text: str, me
 
 
 def test_replay_without_a_level_asks_for_one(traces, tmp_path: Path, capsys) -> None:
-    assert main(["replay", str(traces["grid"]), "--frames", "1"]) == 2
+    # a trace from before traces named their level: the first line without the header fields
+    lines = traces["grid"].read_text().splitlines()
+    first = {k: v for k, v in json.loads(lines[0]).items()
+             if k not in ("level", "level_digest", "abstraction")}
+    old = tmp_path / "old.jsonl"
+    old.write_text("\n".join([json.dumps(first), *lines[1:]]) + "\n")
+    assert main(["replay", str(old), "--frames", "1"]) == 2
     err = capsys.readouterr().err
     assert "--level" in err and len(err.strip().splitlines()) == 1
     assert main(["replay", str(tmp_path / "missing.jsonl"), "--level", "miami"]) == 2

@@ -5,8 +5,9 @@ two lines every agent is moved along the shortest walkable path between its two 
 positions (the navmesh funnel path, so nobody walks through a wall corner), at constant
 speed; a jump longer than any agent can walk in that time (a respawn) is shown as a jump.
 
-The lines carry no level name, so ``--level`` is required unless a line has a ``level``
-key. The node numbers refer to the grid or the partition graph; which one is detected from
+A trace written today names its level and the SHA-256 of its file in the first line, so
+``--level`` is optional and a replay on another level (or an edited file) is refused; an
+older trace without a ``level`` key needs ``--level``. The node numbers refer to the grid or the partition graph; which one is detected from
 the positions (``--abstraction`` overrides).
 """
 
@@ -327,6 +328,11 @@ def cmd_replay(args: argparse.Namespace) -> int:
     if level_name is None:
         raise UserError(f"{args.trace}: the trace does not name its level; pass --level LEVEL")
     level = load_level(level_name)
+    if trace.level_digest is not None and level.digest != trace.level_digest:
+        raise UserError(f"{args.trace}: recorded on level {trace.level or '?'} (sha256 "
+                        f"{trace.level_digest[:12]}), but {level_name} is another level or an "
+                        f"edited file (sha256 {(level.digest or 'none')[:12]}); replay it on "
+                        "the level it was recorded on")
     abstraction = getattr(args, "abstraction", None) or trace.abstraction
     if abstraction is None:
         graphs = {name: graph_for(level, name) for name in ("grid", "partition")}
