@@ -28,6 +28,8 @@ import json
 import sys
 from pathlib import Path
 
+from ai.stimuli import load_stimulus
+
 from .errors import UserError
 from .figures import write_aggregate
 from .heatmaps import HeatSums, write_heatmaps
@@ -77,12 +79,14 @@ def write_report(directory: str | Path, *, figures: bool = True) -> list[Path]:
         raise UserError(f"{store_path}: no finished trials yet"
                         + (f" ({len(failures)} failed)" if failures else ""))
 
+    design = json.loads(meta.get("design", "{}"))
+    for plugin in design.get("stimuli", []):  # their zone kinds, before the levels are read
+        load_stimulus(plugin)
     written: list[Path] = []
     path = directory / "trials.csv"
     write_trials_csv(trials, path)
     written.append(path)
 
-    design = json.loads(meta.get("design", "{}"))
     rows = table_rows(trials, design.get("abstractions"))
     write_table(rows, directory, len(trials))
     written += [directory / "table.md", directory / "table.csv"]
