@@ -196,7 +196,9 @@ def test_mechanics_measures_the_plugin_against_a_paired_control(tmp_path: Path, 
     code = main(["mechanics", "--level", str(LEVEL), "--stimulus", PLUGIN, "--seeds", "4",
                  "--workers", "1", "--out", str(out)])
     assert code == 0
-    table = capsys.readouterr().out
+    captured = capsys.readouterr()
+    table = captured.out
+    assert "4/4 100%" in captured.err and "jobs/s" in captured.err  # progress on stderr
     assert "tripwire: first_detect_time, s (censored at 60)" in table
     rows = list(csv.DictReader(open(out / "mechanics.csv")))
     by = {r["measure"]: r for r in rows}
