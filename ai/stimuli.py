@@ -42,6 +42,7 @@ from typing import Any, ClassVar, NamedTuple
 import numpy as np
 
 from navmesh.graph import UNREACHABLE_HOPS, NodeGraph
+from navmesh.level import register_zone_kind
 
 from . import plugin_call
 from .errors import StimulusError
@@ -176,6 +177,48 @@ class FieldContext:
 # ---------------------------------------------------------------------------- the API
 
 
+#: the directions a :class:`Measure` may intend for a metric: up, down, or none declared
+DIRECTIONS = (+1, -1, 0)
+
+
+@dataclass(frozen=True)
+class Measure:
+    """How ``stealth mechanics --stimulus`` measures a mechanic against a paired control.
+
+    Both arms run the same trials — same level, seed, guard spawns and generators — with
+    the stimulus (arm ``on``) and without it (``control``): ``guards`` against ``player`` in
+    ``scenario``, with the config ``overrides`` in both arms. Each of ``metrics`` is
+    ``(trial metric name, intended direction)``: a name of the trial metrics
+    (``game.metrics``: ``captured``, ``capture_time``, ``first_detect_time``, ``coverage``,
+    ...; times of events that did not happen count as the trial's duration), and ``+1`` if
+    the mechanic should raise it, ``-1`` lower it, ``0`` for no intended direction (the
+    verdict then only says whether it changed). The default asks the question any new
+    mechanic raises first: are the player's captures and detections different with it?
+
+    >>> Measure(metrics=(("captured", +1),)).metrics
+    (('captured', 1),)
+    >>> Measure(metrics=(("captured", 2),))
+    Traceback (most recent call last):
+    ...
+    ai.errors.StimulusError: measure: captured: the direction must be +1, -1 or 0, got 2
+    """
+
+    metrics: tuple[tuple[str, int], ...] = (
+        ("first_detect_time", 0), ("captured", 0), ("capture_time", 0))
+    guards: str = "pf"
+    player: str = "maxmin"
+    scenario: str = "capture"
+    overrides: tuple[tuple[str, Any], ...] = ()
+
+    def __post_init__(self) -> None:
+        if not self.metrics:
+            raise StimulusError("measure: no metrics to measure")
+        for metric, direction in self.metrics:
+            if direction not in DIRECTIONS:
+                raise StimulusError(f"measure: {metric}: the direction must be +1, -1 or 0, "
+                                    f"got {direction!r}")
+
+
 class Stimulus:
     """One mechanic instance: how it injects, how it decays, when it ends.
 
@@ -194,11 +237,22 @@ class Stimulus:
 
     ``node`` is where it is (``-1``: nowhere in particular); stimuli with ``marker`` set are
     drawn by the game and raise ``"guard_on"`` events when a guard steps onto their node.
+
+    Two declarations concern a plugin as a whole:
+
+    * :attr:`zone_kinds` — the level zone kinds the mechanic gives meaning to (e.g.
+      ``("alarm",)``). Loading the plugin (:func:`load_stimulus`) registers each with
+      :func:`navmesh.level.register_zone_kind`, so JSON and Tiled levels loaded afterwards
+      may draw such zones; the stimulus finds their nodes in ``ctx.zones[kind]`` and its own
+      hooks are what the zone does.
+    * :attr:`measure` — how ``stealth mechanics --stimulus`` measures it (:class:`Measure`).
     """
 
     name: str = "stimulus"
     node: int = -1
     marker: bool = False
+    zone_kinds: tuple[str, ...] = ()
+    measure: Measure = Measure()
     #: the index of the level decoy this stimulus is (``-1``: none); the world asks it to
     #: tell whether that decoy is already on
     decoy: int = -1
@@ -704,7 +758,9 @@ def load_stimulus(spec: str) -> StimulusFactory:
     ``Name`` must be a :class:`Stimulus` subclass that can be created with no arguments, or
     a function of no arguments returning a :class:`Stimulus`; installed packages register
     either under the ``stealthfield.stimuli`` entry-point group. The factory is called once
-    here to check it. Raises :class:`StimulusError` (one line) otherwise.
+    here to check it, and the zone kinds it declares (:attr:`Stimulus.zone_kinds`) are
+    registered, so load plugins **before** the levels that use their zones. Raises
+    :class:`StimulusError` (one line) otherwise.
     """
     text = str(spec).strip()
     path_text, sep, attr = text.rpartition(":")
@@ -734,15 +790,33 @@ def load_stimulus(spec: str) -> StimulusFactory:
         ) from None
     if not isinstance(probe, Stimulus):
         raise StimulusError(f"{text}: returned {type(probe).__name__}, not a Stimulus")
+    _register_zone_kinds(text, probe)
+    if not isinstance(probe.measure, Measure):
+        raise StimulusError(f"{text}: measure must be an ai.stimuli.Measure, "
+                            f"got {type(probe.measure).__name__}")
     return obj
+
+
+def _register_zone_kinds(text: str, probe: Stimulus) -> None:
+    """Let levels use the zone kinds ``probe`` declares (before any level is parsed)."""
+    kinds = probe.zone_kinds
+    if not isinstance(kinds, tuple) or not all(isinstance(k, str) for k in kinds):
+        raise StimulusError(f"{text}: zone_kinds must be a tuple of strings, got {kinds!r}")
+    for kind in kinds:
+        try:
+            register_zone_kind(kind)
+        except ValueError as error:
+            raise StimulusError(f"{text}: zone_kinds: {error}") from None
 
 
 __all__ = [
     "DEFAULT_RULES",
+    "DIRECTIONS",
     "ENTRY_POINT_GROUP",
     "Corpse",
     "FieldContext",
     "GuardPresence",
+    "Measure",
     "Noise",
     "Rain",
     "Rule",

@@ -78,9 +78,9 @@ def trial_rngs(spec: TrialSpec, level_name: str) -> Generators:
 def make_world(spec: TrialSpec, config: Config | None = None, **world_kwargs: Any) -> World:
     """Build the world of a trial (level and graph are cached per process)."""
     config = config or Config.load(dict(spec.overrides))
-    level = cached_level(spec.level)
-    if spec.stimuli:
+    if spec.stimuli:  # first: loading a plugin registers the zone kinds its level may use
         world_kwargs.setdefault("stimuli", [load_stimulus(s) for s in spec.stimuli])
+    level = cached_level(spec.level)
     return World(
         level,
         spec.abstraction,

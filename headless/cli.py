@@ -120,6 +120,10 @@ def cmd_validate(args: argparse.Namespace) -> int:
     from navmesh.graph import check_fits
     from navmesh.level import load_level
 
+    from ai.stimuli import load_stimulus
+
+    for plugin in args.stimulus:  # its zone kinds, before the levels that use them
+        load_stimulus(plugin)
     failed = 0
     for name in args.level:
         try:
@@ -165,9 +169,9 @@ def cmd_sim(args: argparse.Namespace) -> int:
     from game.trial import TrialSpec, run_trial, sim_document
     from navmesh.level import load_level
 
-    level = load_level(args.level)  # a bad level fails here with its one-line message
-    for plugin in args.stimulus:
+    for plugin in args.stimulus:  # before the level: a plugin may declare its zone kinds
         load_stimulus(plugin)  # a bad plugin fails here with its one-line message
+    level = load_level(args.level)  # a bad level fails here with its one-line message
     spec = TrialSpec(
         level=args.level,
         abstraction=args.abstraction,
@@ -316,6 +320,12 @@ def build_parser() -> argparse.ArgumentParser:
         p.add_argument("--json", action="store_true",
                        help="print one JSON document on stdout (logs go to stderr)")
 
+    def add_stimulus(p: argparse.ArgumentParser, text: str) -> None:
+        p.add_argument("--stimulus", action="append", default=[], metavar="FILE.py:NAME",
+                       help=f"{text} (a Stimulus subclass or factory in FILE.py, or an "
+                            "installed stealthfield.stimuli entry point); repeatable "
+                            "(default: none)")
+
     def add_set(p: argparse.ArgumentParser) -> None:
         p.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
                        help="override a config value (game/defaults.toml key), e.g. "
@@ -329,6 +339,7 @@ def build_parser() -> argparse.ArgumentParser:
 
     p = command("validate", "check level files: exit 0, or one error line per bad file and exit 2")
     p.add_argument("level", nargs="+", help="level files or bundled names")
+    add_stimulus(p, "load a plugin stimulus first, so its zone kinds are known")
     p.set_defaults(func=cmd_validate)
 
     p = command("path", "navmesh (funnel) path between two points")
@@ -356,9 +367,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--explain", action="store_true",
                    help="add the first guard's decision explained to each trace line "
                         "(to stderr when no --trace)")
-    p.add_argument("--stimulus", action="append", default=[], metavar="FILE.py:NAME",
-                   help="add a stimulus (a Stimulus subclass or factory in FILE.py, or an "
-                        "installed stealthfield.stimuli entry point); repeatable (default: none)")
+    add_stimulus(p, "add a stimulus")
     p.set_defaults(func=cmd_sim)
 
     p = command("mechanics", "measured effects of the stealth mechanics (docs/mechanics.md)")
@@ -369,6 +378,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--level", default="miami", help="level file or bundled name")
     p.add_argument("--abstraction", choices=abstractions, default="grid",
                    help="node graph the AI runs on")
+    add_stimulus(p, "measure this plugin stimulus against a paired control instead of the "
+                    "built-in mechanics")
     p.set_defaults(func=_cmd_mechanics)
 
     p = command("presets", "list the bundled presets with their descriptions")
@@ -409,6 +420,7 @@ def build_parser() -> argparse.ArgumentParser:
                    help="capture: game over at HP 0; fixed: respawn, play the full duration")
     p.add_argument("--mesh", action="store_true", help="start with the grid / navmesh shown")
     p.add_argument("--plans", action="store_true", help="start with the guards' plans shown")
+    add_stimulus(p, "add a stimulus to the game")
     p.set_defaults(func=_cmd_play)
 
     p = command("replay", "replay a trace written by stealth sim --trace")

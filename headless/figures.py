@@ -4,7 +4,10 @@ One bar panel per Table 3 column (:func:`headless.tables.table_columns`), bars p
 mode × player policy with 95 % bootstrap CI whiskers. The grid is derived from the columns:
 one band of rows per scenario (capture first, as in the paper), at most
 :data:`MAX_COLUMNS` panels a row, and the legend in the first free cells (or a row of its
-own) — so a registered metric adds a panel instead of being dropped.
+own) — so a registered metric adds a panel instead of being dropped. Each mode has its
+colour of :mod:`headless.palette`; when the design is the paper's (:mod:`headless.paper`)
+the paper's published value of each bar is drawn on it as a black diamond. Written as PNG
+and SVG.
 """
 
 from __future__ import annotations
@@ -20,10 +23,17 @@ import numpy as np
 from game.metrics import TableColumn
 
 from .filenames import output_path
+from .palette import guard_colour
 from .tables import ABSTRACTION_NAMES, GUARD_NAMES, GUARD_SHORT, PLAYER_NAMES, PLAYER_SHORT, label
 from .tables import table_columns
 
-__all__ = ["MAX_COLUMNS", "Layout", "aggregate_figure", "layout", "write_aggregate"]
+__all__ = ["FORMATS", "MAX_COLUMNS", "Layout", "aggregate_figure", "layout", "write_aggregate"]
+
+FORMATS = ("png", "svg")
+"""Every report figure is written in these formats."""
+
+#: the paper's values, ``{(abstraction, guards, player): {metric name: value}}``
+Paper = Mapping[tuple[str, str, str], Mapping[str, float]]
 
 MAX_COLUMNS = 5
 """Most panels in one row of the figure."""
@@ -72,18 +82,18 @@ def layout(columns: Sequence[TableColumn]) -> Layout:
     return Layout(row, cols, panels, free, cols - free[1])
 
 
-def aggregate_figure(rows: Sequence[Mapping[str, Any]], abstraction: str) -> Any:
+def aggregate_figure(rows: Sequence[Mapping[str, Any]], abstraction: str,
+                     paper: Paper | None = None) -> Any:
     """The matplotlib ``Figure`` of one abstraction's rows of :func:`headless.tables.table_rows`.
 
     Its first axes are the metric panels in :func:`table_columns` order, the last one the
-    legend.
+    legend. With ``paper``, each bar whose cell and metric the paper reports gets the
+    paper's value as a marker.
     """
-    from matplotlib import colormaps
     from matplotlib.figure import Figure
 
     columns = table_columns()
     shape = layout(columns)
-    palette = colormaps["tab10"]
     cells = [r for r in rows if r["abstraction"] == abstraction]
     modes = list(dict.fromkeys(r["guards"] for r in cells))
     players = list(dict.fromkeys(r["player"] for r in cells))
@@ -95,7 +105,7 @@ def aggregate_figure(rows: Sequence[Mapping[str, Any]], abstraction: str) -> Any
     x = np.arange(len(cells))
     labels = [f"{GUARD_SHORT.get(r['guards'], r['guards'])}-"
               f"{PLAYER_SHORT.get(r['player'], r['player'])}" for r in cells]
-    colours = [palette(modes.index(r["guards"]) % 10) for r in cells]
+    colours = [guard_colour(r["guards"]) for r in cells]
     hatches = ["" if players.index(r["player"]) == 0 else "//" for r in cells]
     for ax, column in zip(panels, columns):
         stats = [r["stats"][column.name] for r in cells]
@@ -107,6 +117,12 @@ def aggregate_figure(rows: Sequence[Mapping[str, Any]], abstraction: str) -> Any
                       error_kw={"elinewidth": 0.8})
         for bar, hatch in zip(bars, hatches):
             bar.set_hatch(hatch)
+        if paper is not None:
+            theirs = np.array([paper.get((abstraction, r["guards"], r["player"]), {})
+                               .get(column.metric.name, np.nan) for r in cells])
+            if np.isfinite(theirs).any():
+                ax.plot(x, theirs, linestyle="none", marker="D", markersize=5,
+                        markerfacecolor="black", markeredgecolor="white", zorder=5)
         if np.all(np.isnan(means)):
             ax.text(0.5, 0.5, f"no {column.scenario}-scenario trials", ha="center",
                     va="center", transform=ax.transAxes, color="grey")
@@ -116,24 +132,50 @@ def aggregate_figure(rows: Sequence[Mapping[str, Any]], abstraction: str) -> Any
         ax.set_xticks(x, labels, rotation=60, fontsize=8)
         ax.grid(axis="y", alpha=0.3)
     legend_ax.axis("off")
-    lines = [f"{GUARD_SHORT.get(m, m)} = {label(GUARD_NAMES, m)}" for m in modes]
-    lines += [f"{PLAYER_SHORT.get(p, p)} = {label(PLAYER_NAMES, p)}"
-              + (" (plain bars)" if i == 0 else " (hatched bars)")
-              for i, p in enumerate(players)]
-    lines += ["", "bar: mean over levels and seeds", "whiskers: 95 % bootstrap CI",
-              "of the mean", "uncaptured / undetected trials", "count as the full duration"]
-    legend_ax.text(0.0, 1.0, "\n".join(lines), va="top", fontsize=9, family="monospace")
+    _legend(legend_ax, modes, players, paper is not None)
     fig.suptitle(f"Aggregated performance — {label(ABSTRACTION_NAMES, abstraction)} "
                  "environment (all levels and player policies)", fontsize=13)
     fig.tight_layout(rect=(0, 0, 1, 0.96))
     return fig
 
 
-def write_aggregate(rows: Sequence[Mapping[str, Any]], directory: Path) -> list[Path]:
-    """``aggregate_{abstraction}.png`` per abstraction of ``rows``; returns the files."""
+def _legend(ax: Any, modes: Sequence[str], players: Sequence[str], paper: bool) -> None:
+    """The legend cell: a swatch per mode (its palette colour), plain / hatched per
+    policy, the paper's marker, and how to read a bar."""
+    from matplotlib.lines import Line2D
+    from matplotlib.patches import Patch
+
+    handles: list[Any] = [Patch(facecolor=guard_colour(m), edgecolor="black",
+                                label=f"{GUARD_SHORT.get(m, m)} = {label(GUARD_NAMES, m)}")
+                          for m in modes]
+    handles += [Patch(facecolor="white", edgecolor="black", hatch="" if i == 0 else "//",
+                      label=f"{PLAYER_SHORT.get(p, p)} = {label(PLAYER_NAMES, p)}")
+                for i, p in enumerate(players)]
+    if paper:
+        handles.append(Line2D([], [], linestyle="none", marker="D", markersize=6,
+                              markerfacecolor="black", markeredgecolor="white",
+                              label="the paper's value (Table 3)"))
+    ax.legend(handles=handles, loc="upper left", fontsize=9, frameon=False,
+              bbox_to_anchor=(0.0, 1.0))
+    notes = ["bar: mean over levels and seeds", "whiskers: 95 % bootstrap CI",
+             "of the mean", "uncaptured / undetected trials", "count as the full duration"]
+    ax.text(0.5, 1.0, "\n".join(notes), va="top", fontsize=9, transform=ax.transAxes)
+
+
+def save(fig: Any, stem: Path, **kwargs: Any) -> list[Path]:
+    """``fig`` as ``stem.png`` and ``stem.svg`` (:data:`FORMATS`); returns the files."""
+    paths = [stem.with_name(f"{stem.name}.{fmt}") for fmt in FORMATS]
+    for path in paths:
+        fig.savefig(path, **kwargs)
+    return paths
+
+
+def write_aggregate(rows: Sequence[Mapping[str, Any]], directory: Path,
+                    paper: Paper | None = None) -> list[Path]:
+    """``aggregate_{abstraction}.png`` and ``.svg`` per abstraction of ``rows`` (with the
+    paper's values when given); returns the files."""
     written = []
     for abstraction in dict.fromkeys(r["abstraction"] for r in rows):
-        path = output_path(directory, "aggregate", abstraction, suffix=".png")
-        aggregate_figure(rows, abstraction).savefig(path)
-        written.append(path)
+        written += save(aggregate_figure(rows, abstraction, paper),
+                        output_path(directory, "aggregate", abstraction))
     return written

@@ -50,6 +50,7 @@ from navmesh.level import cached_level, load_level
 
 from .executors import check_workers, process_pool
 from .filenames import output_path
+from .progress import Progress
 from .stats import mean_or_nan, percentile_ci
 
 #: guards cannot see and the player cannot be hurt: only the mechanic informs the guards
@@ -355,9 +356,12 @@ class Summary:
 
     @property
     def verdict(self) -> str:
-        """``yes`` when the difference's CI lies wholly on the intended side of 0."""
+        """``yes`` when the difference's CI lies wholly on the intended side of 0 (with no
+        intended side, ``expected`` 0: ``changed`` when it lies wholly on either side)."""
         if self.n == 0:
             return "no data"
+        if self.expected == 0:
+            return "changed" if self.diff_ci[0] * self.diff_ci[1] > 0 else "no clear change"
         if self.expected * self.diff_ci[0] > 0 and self.expected * self.diff_ci[1] > 0:
             return "yes"
         if self.expected * self.diff > 0:
@@ -376,12 +380,13 @@ def _rng() -> np.random.Generator:
     return np.random.Generator(np.random.PCG64(np.random.SeedSequence(20240101)))
 
 
-def summarise(rows: Sequence[Row]) -> list[Summary]:
-    """Per measure of :data:`EXPECTED`: means, bootstrap CIs and the paired difference."""
+def summarise(rows: Sequence[Row], expected_by_measure: Mapping[str, int] = EXPECTED) -> list[Summary]:
+    """Per measure of ``expected_by_measure`` (default :data:`EXPECTED`, the built-in
+    mechanics'): means, bootstrap CIs and the paired difference."""
     rng = _rng()
     table = _arms(rows)
     out = []
-    for measure, expected in EXPECTED.items():
+    for measure, expected in expected_by_measure.items():
         pairs = np.array(
             [(a["on"], a["control"]) for _, a in sorted(table.get(measure, {}).items())
              if math.isfinite(a.get("on", math.nan)) and math.isfinite(a.get("control", math.nan))],
@@ -431,6 +436,20 @@ def _fmt(value: float, ci: tuple[float, float]) -> str:
     return f"{value:.2f} [{ci[0]:.2f}, {ci[1]:.2f}]"
 
 
+def effects_table(summaries: Sequence[Summary]) -> list[str]:
+    """The Markdown lines of the effects table: one row per measure."""
+    lines = [
+        "| measure | n | mechanic on | control | on − control | intended | as intended |",
+        "|---|---|---|---|---|---|---|",
+    ]
+    arrows = {1: "↑", -1: "↓", 0: "any"}
+    for s in summaries:
+        lines.append(f"| {s.measure} | {s.n} | {_fmt(s.on, s.on_ci)} | "
+                     f"{_fmt(s.control, s.control_ci)} | {_fmt(s.diff, s.diff_ci)} | "
+                     f"{arrows[s.expected]} | {s.verdict} |")
+    return lines
+
+
 def markdown(summaries: Sequence[Summary], curve: Sequence[Mapping[str, Any]], level: str,
              abstraction: str, seeds: int, seconds: float) -> str:
     """The results as Markdown: the effects table and the footstep draw curve."""
@@ -438,14 +457,8 @@ def markdown(summaries: Sequence[Summary], curve: Sequence[Mapping[str, Any]], l
         f"Level {level}, {abstraction}, PF guards, {seeds} paired seeds; mean [95 % bootstrap "
         f"CI over seeds]; computed in {seconds:.0f} s.",
         "",
-        "| measure | n | mechanic on | control | on − control | intended | as intended |",
-        "|---|---|---|---|---|---|---|",
+        *effects_table(summaries),
     ]
-    for s in summaries:
-        arrow = "↑" if s.expected > 0 else "↓"
-        lines.append(f"| {s.measure} | {s.n} | {_fmt(s.on, s.on_ci)} | "
-                     f"{_fmt(s.control, s.control_ci)} | {_fmt(s.diff, s.diff_ci)} | {arrow} | "
-                     f"{s.verdict} |")
     if curve:
         lines += [
             "",
@@ -477,27 +490,30 @@ def run_mechanics(
     """Every (mechanic, seed) with all its arms; returns the rows and the seconds it took."""
     names = list(mechanics or MECHANICS)
     jobs = [(m, level, abstraction, s) for s in range(seeds) for m in names]
+    return run_jobs(run_job, jobs, workers, progress)
+
+
+Job = tuple[str, str, str, int]
+
+
+def run_jobs(func: Callable[[Job], list[Row]], jobs: Sequence[Job], workers: int | None,
+             progress: bool = True) -> tuple[list[Row], float]:
+    """Every job through ``func`` (top-level, picklable) in a process pool of ``workers``
+    (1: in-process) with a progress bar on stderr; the rows sorted, and the seconds it took."""
     started = time.perf_counter()
     rows: list[Row] = []
     workers = workers or min(len(jobs), os.cpu_count() or 1)
-
-    progress = progress and sys.stderr.isatty()
-
-    def collect(result: list[Row], done: int) -> None:
-        rows.extend(result)
-        if progress:
-            print(f"\rmechanics: {done}/{len(jobs)} seed x mechanic", end="", file=sys.stderr,
-                  flush=True)
-
+    bar = Progress(len(jobs), sys.stderr, enabled=progress, unit="jobs")
     if workers <= 1:
-        for k, job in enumerate(jobs, 1):
-            collect(run_job(job), k)
+        for job in jobs:
+            rows.extend(func(job))
+            bar.update(1)
     else:
         with process_pool(workers) as pool:
-            for k, result in enumerate(pool.map(run_job, jobs, chunksize=2), 1):
-                collect(result, k)
-    if progress:
-        print(file=sys.stderr)
+            for result in pool.map(func, jobs, chunksize=2):
+                rows.extend(result)
+                bar.update(1)
+    bar.close()
     rows.sort(key=lambda r: (r[0], r[1], r[2]))
     return rows, time.perf_counter() - started
 
@@ -527,6 +543,10 @@ def cmd_mechanics(args: argparse.Namespace) -> int:
         return 2
     if args.workers is not None:
         check_workers(args.workers)
+    if args.stimulus:
+        from .stimulus_effect import cmd_stimulus_effect
+
+        return cmd_stimulus_effect(args)
     try:
         level = load_level(args.level)
     except ValueError as error:

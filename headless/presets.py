@@ -40,7 +40,7 @@ MAX_PRESET_BYTES = 2**20
 """Largest preset file read (1 MiB)."""
 
 _LIST_FIELDS = ("levels", "abstractions", "guards", "players", "scenarios")
-_ALLOWED_KEYS = (*_LIST_FIELDS, "seeds", "root_seed", "set", "description")
+_ALLOWED_KEYS = (*_LIST_FIELDS, "seeds", "root_seed", "set", "stimuli", "description")
 
 
 @dataclass(frozen=True)
@@ -63,6 +63,8 @@ class Preset:
     config_hash: str = ""
     #: every config value the sweep's trials run with (defaults + the preset's [set])
     config: Mapping[str, Any] = field(default_factory=dict)
+    #: plugin stimuli of every trial (``stimuli = ["file.py:Name"]``; paths made absolute)
+    stimuli: tuple[str, ...] = ()
 
     @property
     def n_trials(self) -> int:
@@ -77,7 +79,7 @@ class Preset:
         return [
             TrialSpec(level=level, abstraction=abstraction, guards=guards, player=player,
                       scenario=scenario, seed=seed, overrides=self.overrides,
-                      root_seed=self.root_seed)
+                      root_seed=self.root_seed, stimuli=self.stimuli)
             for seed in self.seeds
             for level in self.levels
             for abstraction in self.abstractions
@@ -98,6 +100,8 @@ class Preset:
             "seeds": list(self.seeds),
             "root_seed": self.root_seed,
             "set": {k: v for k, v in self.overrides},
+            # only when there are any, so the designs of existing stores stay equal
+            **({"stimuli": list(self.stimuli)} if self.stimuli else {}),
         }
 
 
@@ -211,13 +215,42 @@ def _seeds(data: Mapping[str, Any], src: str) -> tuple[int, ...]:
 
 def _level_ref(name: str, base: Path | None) -> str:
     """A bundled name stays a name; a path is made absolute (relative to the preset file)."""
-    bare = "/" not in name and "\\" not in name and not name.lower().endswith(".json")
+    bare = "/" not in name and "\\" not in name and not name.lower().endswith((".json", ".tmj"))
     if bare:
         return name
     path = Path(name).expanduser()
     if not path.is_absolute() and base is not None:
         path = base / path
     return str(path.resolve())
+
+
+def _stimuli(data: Mapping[str, Any], src: str, base: Path | None) -> tuple[str, ...]:
+    """The ``stimuli`` list, each plugin loaded now (which registers its zone kinds);
+    a ``FILE.py:NAME`` path is made absolute, relative to the preset file."""
+    from ai.errors import StimulusError
+    from ai.stimuli import load_stimulus
+
+    value = data.get("stimuli", [])
+    if not isinstance(value, list) or not all(isinstance(v, str) and v for v in value):
+        raise _fail(src, "stimuli", f"expected a list of FILE.py:NAME or entry-point names, "
+                                    f"got {value!r}")
+    refs = []
+    for text in value:
+        path_text, sep, attr = text.rpartition(":")
+        ref = text
+        if sep and path_text.endswith(".py"):
+            path = Path(path_text).expanduser()
+            if not path.is_absolute() and base is not None:
+                path = base / path
+            ref = f"{path.resolve()}:{attr}"
+        try:
+            load_stimulus(ref)
+        except StimulusError as error:
+            raise _fail(src, "stimuli", str(error)) from None
+        if ref in refs:
+            raise _fail(src, "stimuli", f"{text!r} is listed twice")
+        refs.append(ref)
+    return tuple(refs)
 
 
 def parse_preset(
@@ -288,6 +321,7 @@ def parse_preset(
             raise _fail(src, "players", f"{policy}: cannot be loaded "
                                         f"({type(error).__name__}: {error})") from None
 
+    stimuli = _stimuli(data, src, base)  # before the levels, which may use their zone kinds
     level_names = _names(data, "levels", src, None)
     refs: list[str] = []
     names: list[str] = []
@@ -317,6 +351,7 @@ def parse_preset(
         abstractions=tuple(abstractions), guards=tuple(guards), players=tuple(players),
         scenarios=tuple(scenarios), seeds=seeds, root_seed=root_seed, overrides=overrides,
         description=description, config_hash=config.hash(), config=config.as_dict(),
+        stimuli=stimuli,
     )
 
 

@@ -33,8 +33,9 @@ class Progress:
     """
 
     def __init__(self, total: int, stream: IO[str] | None = None, *, enabled: bool = True,
-                 interval: float = 5.0) -> None:
+                 interval: float = 5.0, unit: str = "trials") -> None:
         self.total = total
+        self.unit = unit
         self.stream = stream if stream is not None else sys.stderr
         self.enabled = enabled
         self.tty = self.stream.isatty()
@@ -53,7 +54,7 @@ class Progress:
         bar = "#" * int(frac * 24) + "." * (24 - int(frac * 24))
         failed = f" {self.failed} failed" if self.failed else ""
         return (f"[{bar}] {self.done}/{self.total} {100 * frac:3.0f}% "
-                f"{rate:5.1f} trials/s ETA {_duration(eta)}{failed}")
+                f"{rate:5.1f} {self.unit}/s ETA {_duration(eta)}{failed}")
 
     def update(self, done: int, failed: int = 0, *, force: bool = False) -> None:
         """Record ``done`` (and ``failed``) more trials and redraw if it is time to."""

@@ -10,6 +10,7 @@ import json
 from collections.abc import Mapping, Sequence
 from pathlib import Path
 
+from .paper import is_paper_design
 from .stats import BOOTSTRAP_RESAMPLES, BOOTSTRAP_SEED
 from .store import STORE_NAME
 from .tables import table_columns
@@ -50,16 +51,24 @@ def readme(directory: Path, meta: Mapping[str, str], done: int, skipped_heat: in
         "| `table.md`, `table.csv` | paper Table 3: mean ± std and 95 % bootstrap CI per "
         "abstraction × guard mode × player policy (`table.csv` also has n per cell) |",
     ]
+    paper = is_paper_design(design)
     for name in names:
         if name.startswith("aggregate_"):
             lines.append(f"| `{name}` | the paper's *Aggregated performance* figure: bars "
-                         "(mean) with 95 % bootstrap CI whiskers per guard mode × policy |")
+                         "(mean) with 95 % bootstrap CI whiskers per guard mode × policy"
+                         + ("; black diamonds: the paper's Table 3 values" if paper else "")
+                         + " |")
     if heat:
         lines.append(f"| `heatmaps/` ({len(heat)} files) | `{{level}}_{{abstraction}}_{{mode}}_"
-                     "{visit,attack}.csv/.png`: per-node counts summed over every trial of "
+                     "{visit,attack}.csv`: per-node counts summed over every trial of "
                      "that level, abstraction and guard mode (all player policies, scenarios "
                      "and seeds). Grid CSV: rows × cols matrix, blank = wall. Partition CSV: "
-                     "`triangle,x,y,value` per navmesh triangle (centroid). |")
+                     "`triangle,x,y,value` per navmesh triangle (centroid). "
+                     "`{level}_{abstraction}_{visit,attack}.png/.svg`: the guard modes side "
+                     "by side on one colour scale (log when the counts span two decades or "
+                     "more); light grey = no events. |")
+    lines.append("| | Each guard mode has one colour in every figure (PotentialField blue, "
+                 "RandomWalk orange, FSM green, Staleness red, Cheat purple). |")
     if failed:
         lines.append("| `failed.csv` | trials that raised: identity and the error text |")
     lines += [

@@ -7,9 +7,11 @@ Everything is written into DIR next to ``results.sqlite``:
   ``wall_time`` last);
 * ``table.md`` / ``table.csv`` — paper Table 3: per abstraction, guard mode and player
   policy, mean ± std and a 95 % bootstrap confidence interval of the mean of each metric;
-* ``heatmaps/{level}_{abstraction}_{mode}_{visit,attack}.{csv,png}`` — summed per-node
-  visit and attack counts;
-* ``aggregate_{abstraction}.png`` — the paper's "Aggregated performance" bar figure;
+* ``heatmaps/{level}_{abstraction}_{mode}_{visit,attack}.csv`` — summed per-node visit and
+  attack counts; ``heatmaps/{level}_{abstraction}_{visit,attack}.{png,svg}`` — the modes
+  side by side on one colour scale;
+* ``aggregate_{abstraction}.{png,svg}`` — the paper's "Aggregated performance" bar figure,
+  with the paper's values overlaid when the design is the paper's;
 * ``failed.csv`` — only when some trial failed;
 * ``README.md`` — what the files are and where our metrics differ from the paper's.
 
@@ -28,9 +30,13 @@ import json
 import sys
 from pathlib import Path
 
+from ai.stimuli import load_stimulus
+
 from .errors import UserError
-from .figures import write_aggregate
-from .heatmaps import HeatSums, write_heatmaps
+from .figures import FORMATS, write_aggregate
+from .heatmaps import HeatSums, figure_count, write_heatmaps
+from .paper import is_paper_design, paper_table3
+from .progress import Progress
 from .readme import readme
 from .stats import BOOTSTRAP_RESAMPLES, BOOTSTRAP_SEED, Stat, bootstrap_ci, summarise
 from .store import IDENTITY, STORE_NAME, ResultStore
@@ -51,11 +57,12 @@ __all__ = [
 ]
 
 
-def write_report(directory: str | Path, *, figures: bool = True) -> list[Path]:
+def write_report(directory: str | Path, *, figures: bool = True,
+                 progress: bool = False) -> list[Path]:
     """Write every report file into ``directory`` (which holds ``results.sqlite``).
 
-    ``figures=False`` skips the PNGs (the CSVs and Markdown are still written).
-    Returns the paths written.
+    ``figures=False`` skips the figures (the CSVs and Markdown are still written);
+    ``progress`` shows a progress bar of the figures on stderr. Returns the paths written.
     """
     directory = Path(directory)
     store_path = directory / STORE_NAME
@@ -77,12 +84,14 @@ def write_report(directory: str | Path, *, figures: bool = True) -> list[Path]:
         raise UserError(f"{store_path}: no finished trials yet"
                         + (f" ({len(failures)} failed)" if failures else ""))
 
+    design = json.loads(meta.get("design", "{}"))
+    for plugin in design.get("stimuli", []):  # their zone kinds, before the levels are read
+        load_stimulus(plugin)
     written: list[Path] = []
     path = directory / "trials.csv"
     write_trials_csv(trials, path)
     written.append(path)
 
-    design = json.loads(meta.get("design", "{}"))
     rows = table_rows(trials, design.get("abstractions"))
     write_table(rows, directory, len(trials))
     written += [directory / "table.md", directory / "table.csv"]
@@ -98,9 +107,15 @@ def write_report(directory: str | Path, *, figures: bool = True) -> list[Path]:
     elif failed_path.exists():
         failed_path.unlink()
 
-    written += write_heatmaps(heat, directory, figures=figures)
+    abstractions = len(dict.fromkeys(r["abstraction"] for r in rows))
+    bar = Progress(figure_count(heat) + abstractions, sys.stderr,
+                   enabled=progress and figures, unit="figures")
+    written += write_heatmaps(heat, directory, figures=figures, tick=lambda: bar.update(1))
     if figures:
-        written += write_aggregate(rows, directory)
+        paper = paper_table3() if is_paper_design(design) else None
+        written += write_aggregate(rows, directory, paper)
+        bar.update(abstractions)
+    bar.close()
 
     path = directory / "README.md"
     path.write_text(readme(directory, meta, len(trials), heat.skipped, len(failures),
@@ -114,8 +129,9 @@ def cmd_report(args: argparse.Namespace) -> int:
     directory = Path(args.dir)
     if not directory.is_dir():
         raise UserError(f"{directory}: no such results directory")
-    written = write_report(directory)
-    pngs = sum(1 for p in written if p.suffix == ".png")
-    print(f"stealth: wrote {len(written)} files ({pngs} figures) into {directory}; "
+    written = write_report(directory, progress=True)
+    shown = sum(1 for p in written if p.suffix == f".{FORMATS[0]}")
+    print(f"stealth: wrote {len(written)} files ({shown} figures, as "
+          f"{' and '.join(FORMATS)}) into {directory}; "
           f"start with {directory / 'README.md'}", file=sys.stderr)
     return 0

@@ -20,7 +20,7 @@ from headless.sweep import run_sweep
 
 ROOT = Path(__file__).resolve().parent.parent
 HOSTILE = ["../../x", "a/b", "a-b", "A-B", "a_b", "NUL", "\x00", "Münster", "..", "ok"]
-SAFE = re.compile(r"[a-z0-9.-]+(_[a-z0-9.-]+)*\.(csv|png)")
+SAFE = re.compile(r"[a-z0-9.-]+(_[a-z0-9.-]+)*\.(csv|png|svg)")
 
 PRESET = """
 levels = {levels}
@@ -58,7 +58,8 @@ def test_a_report_of_hostile_level_names_stays_inside_and_keeps_every_level(tmp_
     after = {p for p in tmp_path.rglob("*") if not p.is_relative_to(out)}
     assert after == before  # nothing outside the results directory
     heat = sorted(p.name for p in (out / "heatmaps").iterdir())
-    assert len(heat) == len(HOSTILE) * 2 * 2  # one visit and one attack CSV + PNG per level
+    # per level: a visit and an attack CSV of its one mode, and the two figures as PNG + SVG
+    assert len(heat) == len(HOSTILE) * (2 + 2 * 2)
     assert all(SAFE.fullmatch(name) for name in heat), heat
     assert all(p.resolve().is_relative_to(out.resolve()) for p in written)
     assert "ok_grid_random_visit.csv" in heat  # a plain name keeps its file name

@@ -59,15 +59,19 @@ def read(path: Path) -> list[dict[str, str]]:
 # ------------------------------------------------------------------------- files
 def test_report_writes_every_file(swept: Path) -> None:
     for name in ("trials.csv", "table.md", "table.csv", "README.md", "aggregate_grid.png",
-                 "aggregate_partition.png"):
+                 "aggregate_partition.png", "aggregate_grid.svg", "aggregate_partition.svg"):
         assert (swept / name).is_file(), name
     for level in ("maze", "miami"):
         for abstraction in ("grid", "partition"):
-            for mode in ("cheat", "random"):
-                for kind in ("visit", "attack"):
-                    for suffix in ("csv", "png"):
-                        name = f"{level}_{abstraction}_{mode}_{kind}.{suffix}"
-                        assert (swept / "heatmaps" / name).is_file(), name
+            for kind in ("visit", "attack"):
+                for mode in ("cheat", "random"):
+                    name = f"{level}_{abstraction}_{mode}_{kind}.csv"
+                    assert (swept / "heatmaps" / name).is_file(), name
+                for suffix in ("png", "svg"):  # the modes side by side, one figure
+                    name = f"{level}_{abstraction}_{kind}.{suffix}"
+                    assert (swept / "heatmaps" / name).is_file(), name
+    assert not list((swept / "heatmaps").glob("*_cheat_*.png"))
+    assert (swept / "aggregate_grid.svg").read_text().lstrip().startswith("<?xml")
     assert not (swept / "failed.csv").exists()
     readme = (swept / "README.md").read_text()
     assert "32 of 32 trials finished" in readme
@@ -138,9 +142,9 @@ def test_pngs_are_real_non_blank_images(swept: Path) -> None:
     from matplotlib.image import imread
 
     pngs = [swept / "aggregate_grid.png", swept / "aggregate_partition.png",
-            swept / "heatmaps" / "miami_grid_cheat_visit.png",
-            swept / "heatmaps" / "miami_partition_random_attack.png",
-            swept / "heatmaps" / "maze_partition_cheat_visit.png"]
+            swept / "heatmaps" / "miami_grid_visit.png",
+            swept / "heatmaps" / "miami_partition_attack.png",
+            swept / "heatmaps" / "maze_partition_visit.png"]
     for path in pngs:
         image = imread(path)
         assert image.ndim == 3 and image.shape[0] >= 300 and image.shape[1] >= 400, path
@@ -259,3 +263,101 @@ def test_report_errors_are_one_line_exit_2(tmp_path: Path,
     assert len(lines) == 3 and all(line.startswith("stealth: error: ") for line in lines)
     assert "no such results directory" in lines[0] and "no results.sqlite" in lines[1]
     assert "no finished trials" in lines[2]
+
+
+# ------------------------------------------------------------------------- comparable figures
+def test_report_shows_progress_on_stderr(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    n_nodes = graph_for(load_level("maze"), "grid").n
+    with ResultStore(tmp_path / "results.sqlite") as store:
+        _add(store, n_nodes, "pf", "capture", 0, captured=True, capture_time=3.0)
+    assert main(["report", str(tmp_path)]) == 0
+    err = capsys.readouterr().err
+    assert "3/3 100%" in err and "figures/s" in err  # 2 heatmap figures + 1 aggregate
+
+
+def test_a_mode_keeps_its_colour_whatever_the_report_holds() -> None:
+    from matplotlib.colors import to_hex
+
+    from headless.figures import aggregate_figure
+    from headless.palette import guard_colour
+    from headless.stats import Stat
+
+    def rows(modes: list[str]) -> list[dict[str, Any]]:
+        stat = Stat(4, 1.0, 0.1, 0.9, 1.1)
+        return [{"abstraction": "grid", "guards": m, "player": "maxmin",
+                 "stats": {c.name: stat for c in table_columns()}} for m in modes]
+
+    def bar_colours(modes: list[str]) -> dict[str, str]:
+        ax = aggregate_figure(rows(modes), "grid").axes[0]
+        return {m: to_hex(bar.get_facecolor()) for m, bar in zip(modes, ax.patches)}
+
+    one, other = bar_colours(["pf", "cheat"]), bar_colours(["cheat", "random", "pf"])
+    assert one["pf"] == other["pf"] == guard_colour("pf")
+    assert one["cheat"] == other["cheat"] == guard_colour("cheat") != guard_colour("pf")
+    assert len({guard_colour(m) for m in ("pf", "random", "fsm", "staleness", "cheat")}) == 5
+
+
+def _panels(values: dict[str, np.ndarray]) -> Any:
+    from headless.heatmaps import Panel, heatmap_panels
+
+    level = load_level("maze")
+    graph = graph_for(level, "grid")
+    panels = [Panel(mode, np.resize(v, graph.n).astype(float), 3) for mode, v in values.items()]
+    return heatmap_panels(level, graph, panels, "visit", "grid")
+
+
+def test_heatmap_panels_share_one_scale_log_when_counts_span_decades() -> None:
+    from matplotlib.colors import LogNorm
+
+    fig = _panels({"pf": np.array([1.0, 5.0, 0.0]), "cheat": np.array([3000.0, 0.0])})
+    norms = [ax.images[0].norm for ax in fig.axes if ax.images]
+    assert len(norms) == 2 and all(n is norms[0] for n in norms)
+    assert isinstance(norms[0], LogNorm) and (norms[0].vmin, norms[0].vmax) == (1.0, 3000.0)
+    titles = [ax.get_title() for ax in fig.axes if ax.images]
+    assert titles == ["PotentialField (3 trials)", "Cheat (3 trials)"]  # registry order
+    fig = _panels({"pf": np.array([1.0, 5.0]), "cheat": np.array([2.0, 0.0])})
+    norm = fig.axes[0].images[0].norm
+    assert not isinstance(norm, LogNorm) and (norm.vmin, norm.vmax) == (0.0, 5.0)
+
+
+def test_no_events_are_drawn_as_such() -> None:
+    from matplotlib.colors import to_hex
+
+    from headless.heatmaps import NO_EVENTS
+
+    fig = _panels({"pf": np.array([0.0]), "random": np.array([2.0, 0.0])})
+    empty, some = (ax for ax in fig.axes if ax.images)
+    assert "no events" in [t.get_text() for t in empty.texts]
+    assert "no events" not in [t.get_text() for t in some.texts]
+    image = some.images[0]
+    rgba = image.cmap(image.norm(image.get_array()))  # every drawn node's colour
+    level = load_level("maze")
+    walkable = level.occupancy
+    zero_cells = rgba[walkable][1::2]  # the resized values alternate 2, 0 along the nodes
+    assert {to_hex(c) for c in zero_cells} == {to_hex(NO_EVENTS)}
+    labels = [t.get_text() for t in fig.legends[0].get_texts()]
+    assert labels == ["no events (0)", "wall"]
+
+
+def test_the_paper_values_are_overlaid_only_on_the_papers_design() -> None:
+    from headless.figures import aggregate_figure
+    from headless.paper import is_paper_design, paper_table3
+    from headless.stats import Stat
+
+    stat = Stat(4, 0.5, 0.1, 0.4, 0.6)
+    rows = [{"abstraction": "grid", "guards": m, "player": p,
+             "stats": {c.name: stat for c in table_columns()}}
+            for m in ("pf", "cheat") for p in ("maxmin", "safetygraph")]
+    paper = paper_table3()
+    fig = aggregate_figure(rows, "grid", paper)
+    (markers,) = [line for line in fig.axes[0].lines if line.get_marker() == "D"]
+    assert list(markers.get_ydata()) == [0.80, 0.80, 0.95, 0.95]  # CaptureRate: PF, Cheat
+    assert not [line for line in aggregate_figure(rows, "grid").axes[0].lines
+                if line.get_marker() == "D"]
+    design = {"level_names": ["arkham", "dishonored", "maze", "miami", "tlou"],
+              "abstractions": ["grid", "partition"], "guards": ["pf", "cheat"],
+              "players": ["maxmin"]}
+    assert is_paper_design(design)
+    assert not is_paper_design({**design, "level_names": ["maze", "miami"]})
+    assert not is_paper_design({**design, "players": ["evade"]})
+    assert not is_paper_design({**design, "stimuli": ["x.py:Y"]})

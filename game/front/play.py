@@ -76,6 +76,8 @@ class PlaySettings:
     overlay: str = "none"
     show_mesh: bool = False
     show_plans: bool = False
+    #: plugin stimuli, ``"FILE.py:NAME"`` or entry-point names (``--stimulus``)
+    stimuli: tuple[str, ...] = ()
 
 
 class PlayGame(FrameLoop):
@@ -131,7 +133,7 @@ class PlayGame(FrameLoop):
         spec = TrialSpec(
             level=self.settings.level, abstraction=self.settings.abstraction, guards=mode,
             player=self.autopilot or "evade", scenario=self.settings.scenario,
-            seed=self.settings.seed,
+            seed=self.settings.seed, stimuli=self.settings.stimuli,
         )
         world = make_world(spec, self.config, interactive=True)
         if self.autopilot is None:
@@ -329,8 +331,11 @@ def finish(surface: pygame.Surface, screenshot: str | None, times: Sequence[floa
 
 def cmd_play(args: argparse.Namespace) -> int:
     """``stealth play LEVEL``: see the module docstring and docs/play.md."""
+    from ai.stimuli import load_stimulus
     from navmesh.level import load_level
 
+    for plugin in args.stimulus:  # before the level: a plugin may declare its zone kinds
+        load_stimulus(plugin)  # a bad plugin fails here with its one-line message
     load_level(args.level)  # a bad level fails here with its one-line message
     try:
         overlay = overlay_key(args.overlay)
@@ -345,7 +350,7 @@ def cmd_play(args: argparse.Namespace) -> int:
         level=args.level, guards=args.guards, abstraction=args.abstraction,
         scenario=args.scenario, seed=args.seed,
         overrides=tuple(args.set), autopilot=args.autopilot, overlay=overlay,
-        show_mesh=args.mesh, show_plans=args.plans,
+        show_mesh=args.mesh, show_plans=args.plans, stimuli=tuple(args.stimulus),
     )
     open_display()
     game = PlayGame(settings, lockstep=lockstep_wanted(args.frames))
