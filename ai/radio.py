@@ -8,7 +8,7 @@ A report nobody was in range to hear is lost. While a report is live the team's 
 is kept at least ``alert_weight`` (0: no floor).
 
 *Missing teammate*: every active guard checks in each AI tick; a guard that stops (taken
-down) for ``missing_time`` seconds is reported missing at its last node to every active
+down) is reported ``missing_time`` seconds after the first tick it failed to check in, is reported missing at its last node to every active
 teammate (the team radio: no range).
 
 One :class:`Radio` stimulus does all of it, so the guard AI never learns about radios.
@@ -153,7 +153,7 @@ class Radio(Stimulus):
                 self._last_node[j] = int(view.guard_nodes[j])
                 self._silent_since.pop(j, None)
                 continue
-            since = self._silent_since.setdefault(j, t - dt)
+            since = self._silent_since.setdefault(j, t)
             if j not in self._missing_sent and t - since >= p.missing_time - 1e-9:
                 self._missing_sent.add(j)
                 self.send(view, "missing", self._last_node.get(j, int(view.guard_nodes[j])), -1)
