@@ -49,6 +49,7 @@ from game.world import World
 from navmesh.graph import NodeGraph
 from navmesh.level import cached_level, load_level
 
+from .mechanics_ai import AI_EXPECTED, AI_MECHANICS
 from .stats import mean_or_nan, percentile_ci
 
 #: guards cannot see and the player cannot be hurt: only the mechanic informs the guards
@@ -301,6 +302,7 @@ MECHANICS: dict[str, Callable[[str, str, int], Measures]] = {
     "dark": dark,
     "concealment": concealment,
     "rain": rain,
+    **AI_MECHANICS,  # beyond the paper: perception, alert, radio, roles (headless/mechanics_ai.py)
 }
 
 #: the direction each measure should move when the mechanic is on: +1 up, -1 down
@@ -317,6 +319,7 @@ EXPECTED: dict[str, int] = {
     "concealment: time to first detection, s (censored at 30)": +1,
     "concealment: distance of the guard at first detection, units": -1,
     "rain: share of footsteps 1-8 hops away that draw a guard": -1,
+    **AI_EXPECTED,
 }
 
 Row = tuple[str, int, str, float]  # measure, seed, arm, value

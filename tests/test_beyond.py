@@ -292,3 +292,11 @@ def test_a_bad_value_is_a_one_line_config_error() -> None:
     config = Config.load(["alert.enabled=true", "alert.speed_alert=3"])
     with pytest.raises(ConfigError, match=r"^\[alert\]: AlertParams: speed_alert must be in"):
         TeamRules.build(config, 3, StimulusSet(NodeGraph.from_grid(np.ones((1, 5), bool), 1.0)))
+
+
+def test_stealth_mechanics_measures_each_new_rule_against_a_control() -> None:
+    from headless.mechanics import EXPECTED, MECHANICS
+
+    assert {"perception", "alert", "radio", "roles"} <= set(MECHANICS)
+    for name in ("perception", "alert", "radio", "roles"):
+        assert any(measure.startswith(name + ":") for measure in EXPECTED)
