@@ -3,8 +3,10 @@
 A guard that detects the player, or finds a corpse, sends a report; after ``delay``
 seconds the report reaches every teammate that was within ``range`` (world units) of the
 sender when it was sent, and enters the shared information field as a decaying layer at
-the reported node, ``−level · falloff^hops`` (``level ← level · decay^dt``), like a noise.
-A report nobody was in range to hear is lost. While a report is live the team's ``w_I``
+the reported node, ``−level · falloff^hops`` (``level ← level · decay^dt``), like a noise;
+a heard sighting report replaces the older ones, and a new detection by the team drops
+them (the shared field's own sighting is fresher), so a report acts as the last known
+position once the team has lost sight. A report nobody was in range to hear is lost. While a report is live the team's ``w_I``
 is kept at least ``alert_weight`` (0: no floor).
 
 *Missing teammate*: every active guard checks in each AI tick; a guard that stops (taken
@@ -140,6 +142,8 @@ class Radio(Stimulus):
         elif view.sighting is not None:
             where = int(view.sighting)
             detected = (_nearest_active(view, where),)
+        if detected:  # the team's own sighting is fresher than any heard position
+            self.live = [r for r in self.live if r.kind != "sighting"]
         for i in detected:
             if i >= 0 and active[i] and t - self._last_report.get(i, -np.inf) >= p.cooldown - 1e-9:
                 self._last_report[i] = t
@@ -165,6 +169,8 @@ class Radio(Stimulus):
         for report in due:
             if report.hearers:
                 report.level = self.params.amplitude
+                if report.kind == "sighting":  # the latest position replaces older ones
+                    self.live = [r for r in self.live if r.kind != "sighting"]
                 self.live.append(report)
 
     # ------------------------------------------------------------------ the layer

@@ -8,6 +8,7 @@ Each against its control on the same seed (docs/mechanics.md), PF guards, scenar
 | perception | graded perception on; a still player in a dark cell, guards see | off (instant detection) | time to first detection (censored at 30 s) |
 | alert | alert phases on; MaxMin player, guards see | off | captures in 60 s |
 | radio | guard communication on; MaxMin player | off | captures in 60 s |
+| radio | guard 0 taken down at 0 s, no corpse, blind guards, radio on | off | nearest guard hops to its last node, 10–30 s |
 | roles | coordinated roles on; MaxMin player | off | captures in 60 s; backtracks |
 """
 
@@ -82,10 +83,37 @@ def _captures(switch: str) -> Callable[[str, str, int], Measures]:
     return measure
 
 
+def missing(level: str, abstraction: str, seed: int) -> Measures:
+    """Guard 0 taken down at t = 0, no corpse rule, blind guards: the nearest active
+    guard's mean hop distance to its last node in 10–30 s, radio (missing report) vs none."""
+    from .mechanics import BLIND, active_guard_nodes, make_world, run_until
+
+    out = {}
+    for arm, on in (("on", True), ("control", False)):
+        world = make_world(level, abstraction, seed, {**BLIND, "radio.enabled": on})
+        world.stimuli.disable("guard_down")
+        body = world.guards[0].node
+        world.down_guard(0)
+        track: list[float] = []
+
+        def watch(w: Any, track: list[float] = track, body: int = body) -> None:
+            if w.step_index % w.steps_per_tick == 0 and w.t > 10.0 - 1e-9:
+                track.append(float(w.graph.hops[active_guard_nodes(w), body].min()))
+
+        run_until(world, 30.0, watch)
+        out[arm] = float(np.mean(track))
+    return {"radio: nearest guard hops to a missing teammate, 10-30 s": out}
+
+
+def radio(level: str, abstraction: str, seed: int) -> Measures:
+    """Radio: captures of a MaxMin player, and the missing-teammate report."""
+    return {**_captures("radio")(level, abstraction, seed), **missing(level, abstraction, seed)}
+
+
 AI_MECHANICS: dict[str, Callable[[str, str, int], Measures]] = {
     "perception": perception,
     "alert": _captures("alert"),
-    "radio": _captures("radio"),
+    "radio": radio,
     "roles": _captures("roles"),
 }
 
@@ -93,6 +121,7 @@ AI_EXPECTED: dict[str, int] = {
     "perception: time to first detection in the dark, s (censored at 30)": +1,
     "alert: captures of a MaxMin player in 60 s": +1,
     "radio: captures of a MaxMin player in 60 s": +1,
+    "radio: nearest guard hops to a missing teammate, 10-30 s": -1,
     "roles: captures of a MaxMin player in 60 s": +1,
     "roles: guard backtracks in 60 s": -1,
 }
