@@ -424,6 +424,7 @@ class CompositeField:
         rng: np.random.Generator,
         teammates: Sequence[int] | np.ndarray = (),
         recent: Sequence[int] | np.ndarray = (),
+        personal: np.ndarray | None = None,
     ) -> Choice:
         """argmin K over the candidates of ``node`` (eq. 7); ties within tie_eps drawn with ``rng``.
 
@@ -431,6 +432,8 @@ class CompositeField:
         ``w_C · teammate_presence · C0 · (Kmat @ γ_C^d(g, ·))`` is added to K (docs/ai.md).
         ``recent`` are the deciding guard's last visited nodes: a candidate among them gets
         ``w_C · revisit_penalty · C0`` added (eq. 10, unsmoothed, docs/ai.md).
+        ``personal`` is the deciding guard's own field term (a coordinated role, docs/ai.md
+        "Beyond the paper"), added unsmoothed at the candidates; None: the paper.
         """
         candidates = self.matrices.candidates[node]
         if len(candidates) == 0:
@@ -443,6 +446,8 @@ class CompositeField:
         revisit = self.revisit_term(candidates, recent)
         if revisit is not None:
             scores = scores + revisit
+        if personal is not None:
+            scores = scores + personal[candidates]
         tied = candidates[scores - scores.min() < self.params.tie_eps]
         winner = tied[0] if len(tied) == 1 else tied[rng.integers(len(tied))]
         return Choice(int(winner), candidates, scores, tied)

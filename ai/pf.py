@@ -16,7 +16,7 @@ import numpy as np
 
 from navmesh.graph import NodeGraph
 
-from .fields import Choice, CompositeField, active_guard_nodes, sighting_node
+from .fields import Choice, CompositeField, active_guard_nodes, information_layer, sighting_node
 from .params import PFParams
 from .view import GuardAI, WorldView
 
@@ -36,6 +36,8 @@ class _Decision:
     weights: tuple[float, float, float]
     teammates: np.ndarray
     recent: tuple[int, ...]
+    personal: np.ndarray | None = None
+    role: dict[str, Any] | None = None
 
 
 class PotentialFieldGuards(GuardAI):
@@ -68,6 +70,8 @@ class PotentialFieldGuards(GuardAI):
         self._last: list[_Decision | None] = [None] * n_guards
         #: each guard's last 5 decided nodes (the window the backtrack metric uses)
         self._recent: list[deque[int]] = [deque(maxlen=5) for _ in range(n_guards)]
+        #: per guard, its own field term and why (coordinated roles), else None
+        self._personal: list[tuple[np.ndarray, dict[str, Any]] | None] = [None] * n_guards
 
     def tick(self, view: WorldView, dt: float) -> None:
         """Decay and refresh I and C, adapt the weights (eqs. 1–3, 8)."""
@@ -87,7 +91,9 @@ class PotentialFieldGuards(GuardAI):
         recent = self._recent[i]
         if not recent or recent[-1] != node:
             recent.append(node)
-        choice = field.select(node, self.rng, teammates, recent)
+        own = self._personal[i] if 0 <= i < len(self._personal) else None
+        personal = None if own is None else own[0]
+        choice = field.select(node, self.rng, teammates, recent, personal)
         self._last[i] = _Decision(
             t=float(view.t),
             node=node,
@@ -100,6 +106,8 @@ class PotentialFieldGuards(GuardAI):
             weights=field.weights,
             teammates=teammates,
             recent=tuple(recent),
+            personal=personal,
+            role=None if own is None else own[1],
         )
         return choice.winner
 
@@ -136,6 +144,13 @@ class PotentialFieldGuards(GuardAI):
         """Zones hook: confidence decay ``rate`` per second in ``nodes`` (indices or a mask)."""
         self.field.set_confidence_decay(nodes, rate)
 
+    def set_guard_information(self, i: int, layer: np.ndarray | None,
+                              why: Mapping[str, Any] | None = None) -> None:
+        """Roles hook: guard ``i``'s own term, added to its K at its next decisions."""
+        if 0 <= i < len(self._personal):
+            self._personal[i] = None if layer is None else (
+                information_layer(layer, self.graph.n), dict(why or {}))
+
     # ------------------------------------------------------------------ explainability
     def explain(self, i: int) -> dict[str, Any] | None:
         """Guard ``i``'s last decision: candidates with I, I_extra, C, C_live, N, P, K, winner.
@@ -168,7 +183,12 @@ class PotentialFieldGuards(GuardAI):
             }
             for c, k in zip(record.choice.candidates, record.choice.scores, strict=True)
         ]
+        if record.personal is not None:
+            for entry, c in zip(candidates, record.choice.candidates, strict=True):
+                entry["role_term"] = float(record.personal[c])
+        role = {"role": record.role} if record.role is not None else {}
         return {
+            **role,
             "mode": self.mode,
             "guard": int(i),
             "t": record.t,

@@ -279,6 +279,14 @@ class Stimulus:
         """How a new noise sounds while this stimulus is active (default: unchanged)."""
         return sound
 
+    def guard_layers(self, ctx: FieldContext) -> Mapping[int, tuple[np.ndarray, Mapping[str, Any]]]:
+        """Field terms for single guards: guard index → (layer (n,), why) (default: none).
+
+        Coordinated roles (:mod:`ai.roles`) give each guard its own pull this way; the set
+        hands them to ``guard_ai.set_guard_information``.
+        """
+        return {}
+
     def describe(self) -> dict[str, Any]:
         """A JSON-able summary for traces."""
         return {"name": self.name, "node": int(self.node)}
@@ -549,6 +557,7 @@ class StimulusSet:
         self._active: list[Stimulus] = []
         self._pushed_zero = True
         self._pushed_floor = 0.0
+        self._pushed_guards: frozenset[int] = frozenset()
 
     @property
     def active(self) -> tuple[Stimulus, ...]:
@@ -638,6 +647,14 @@ class StimulusSet:
         if floor != self._pushed_floor:
             guards.set_information_weight_floor(floor)
             self._pushed_floor = floor
+        personal: dict[int, tuple[np.ndarray, Mapping[str, Any]]] = {}
+        for stimulus in self._active:
+            personal.update(stimulus.guard_layers(self.ctx))
+        for i in sorted(self._pushed_guards - personal.keys()):
+            guards.set_guard_information(i, None)
+        for i, (values, why) in sorted(personal.items()):
+            guards.set_guard_information(i, values, why)
+        self._pushed_guards = frozenset(personal)
 
     def markers(self) -> list[Stimulus]:
         """Active stimuli the game draws (decoys, corpses, landed throws)."""

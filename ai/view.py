@@ -169,6 +169,13 @@ class GuardAI(ABC):
     def set_confidence_decay(self, nodes: np.ndarray, rate: float) -> None:
         """Let confidence decay at ``rate`` per second on ``nodes`` (a zone; default: ignored)."""
 
+    def set_guard_information(self, i: int, layer: np.ndarray | None,
+                              why: Mapping[str, Any] | None = None) -> None:
+        """Receive a field term for guard ``i`` alone, shape ``(n,)`` (``≤ 0`` attracts),
+        added to that guard's K at its decisions; ``None`` clears it. ``why`` is a JSON-able
+        record of where the term comes from (a coordinated role), for :meth:`explain`.
+        Default: ignored."""
+
 
 @dataclass(frozen=True)
 class Action:

@@ -222,6 +222,10 @@ class GuardDrawing:
     candidates: np.ndarray = field(default_factory=lambda: np.zeros((0, 2)))
     #: position of the chosen candidate (PF only, with plans)
     chosen: Point | None = None
+    #: awareness as a fraction of the detection threshold (graded perception on), else None
+    awareness: float | None = None
+    #: coordinated role ("" when roles are off or the guard has none)
+    role: str = ""
 
 
 @dataclass(frozen=True)
@@ -292,6 +296,8 @@ class Scene:
     rain: bool | None = None
     events: tuple[str, ...] = ()
     captures: int = 0
+    #: the guard team's alert phase ("" when alert phases are off)
+    phase: str = ""
 
     @property
     def detected(self) -> bool:
@@ -362,10 +368,11 @@ class SceneBuilder:
         seen = set(world.seen_by)
         positions = self.graph.positions
         guard_ai = world.guard_ai
+        team_top, team_guards = world.team.trace_fields(world)
         guards = []
         for i, g in enumerate(world.guards):
             cone = self.cone(g.pos, g.heading, reach) if g.active else np.zeros((0, 2))
-            extra: dict[str, Any] = {}
+            extra: dict[str, Any] = dict(team_guards[i])
             if plans and g.active:
                 extra["target"] = (float(positions[g.target][0]), float(positions[g.target][1]))
                 extra["path"] = np.asarray(list(g.waypoints), dtype=np.float64).reshape(-1, 2)
@@ -416,6 +423,7 @@ class SceneBuilder:
             rain=world.raining,
             events=tuple(e.kind for e in world.tick_events),
             captures=world.m.captures,
+            phase=str(team_top.get("phase", "")),
         )
 
 

@@ -22,7 +22,11 @@ from collections.abc import Iterable, Mapping
 from typing import TYPE_CHECKING, Any
 
 from ai.bounds import COUNT, FLAG, NON_NEGATIVE, POSITIVE, Bound, OneOf, Range
+from ai.alert import AlertParams
+from ai.awareness import AwarenessParams
 from ai.params import FSMParams, PFParams, PlayerParams, StalenessParams
+from ai.radio import RadioParams
+from ai.roles import RoleParams
 from ai.stimuli import StimulusParams, Zone, zones_from_config
 from navmesh.level import ZONE_KINDS
 
@@ -80,6 +84,10 @@ SCENARIO: Mapping[str, Bound] = {
 _PLAYER_OWN = {k: v for k, v in PlayerParams.bounds.items()
                if k not in ("guard_speed", "player_speed")}  # those come from [world]
 
+#: the switchable rules beyond the paper: config section -> parameter class
+_TEAM_RULES: Mapping[str, Any] = {"awareness": AwarenessParams, "alert": AlertParams,
+                                  "radio": RadioParams, "roles": RoleParams}
+
 _SECTIONS: Mapping[str, Mapping[str, Bound]] = {
     "world": WORLD,
     "zones": {f"{kind}_{name}": bound for kind in ZONE_KINDS for name, bound in Zone.bounds.items()},
@@ -88,6 +96,8 @@ _SECTIONS: Mapping[str, Mapping[str, Bound]] = {
     "fsm": FSMParams.bounds,
     "staleness": StalenessParams.bounds,
     "player": _PLAYER_OWN,
+    # beyond the paper (docs/ai.md): each section's switch plus its parameter class
+    **{name: {"enabled": FLAG, **cls.bounds} for name, cls in _TEAM_RULES.items()},
 }
 
 
@@ -117,6 +127,8 @@ def check_sections(values: Mapping[str, Any]) -> None:
         ("fsm", FSMParams, _section(values, "fsm")),
         ("staleness", StalenessParams, _section(values, "staleness")),
     ]
+    builds += [(name, cls, {k: v for k, v in _section(values, name).items() if k != "enabled"})
+               for name, cls in _TEAM_RULES.items()]
     stimuli = _section(values, "stimuli")
     actions = {k: v for k, v in stimuli.items() if k in ActionParams.bounds}
     builds.append(("stimuli", ActionParams, actions))

@@ -36,7 +36,10 @@ def _round(value: float | None) -> float | None:
 
 
 def trace_record(world: World) -> dict[str, Any]:
-    """One trace line (SPEC §9): time, agents, who sees the player, HP, events."""
+    """One trace line (SPEC §9): time, agents, who sees the player, HP, events; with the
+    mechanics beyond the paper on (game.team) also ``phase`` and per guard ``awareness``
+    and ``role``."""
+    top, per_guard = world.team.trace_fields(world)
     return {
         "t": _round(world.t),
         "player": {
@@ -53,6 +56,7 @@ def trace_record(world: World) -> dict[str, Any]:
                 "target": g.target,
                 "state": world.guard_ai.state_name(i),
                 "active": g.active,
+                **per_guard[i],
             }
             for i, g in enumerate(world.guards)
         ],
@@ -62,6 +66,7 @@ def trace_record(world: World) -> dict[str, Any]:
         ],
         **({"stimuli": [call(s, s.describe) for s in world.stimuli.active]}
            if world.stimuli else {}),
+        **top,
     }
 
 
@@ -126,6 +131,10 @@ class GuardRecord:
     target: int | None = None
     state: str = ""
     active: bool = True
+    #: awareness as a fraction of the detection threshold (graded perception), else None
+    awareness: float | None = None
+    #: coordinated role (``chaser``, ``interceptor``, ``holder``; "" none)
+    role: str = ""
 
 
 @dataclass(frozen=True)
@@ -140,6 +149,8 @@ class TraceLine:
     events: tuple[str, ...]
     #: nodes of the active stimuli that sit somewhere (decoys, corpses, throws), if traced
     markers: tuple[int, ...] = ()
+    #: the team's alert phase, if traced ("" otherwise)
+    phase: str = ""
 
 
 @dataclass(frozen=True)
@@ -214,6 +225,9 @@ def parse_line(record: Any, where: str) -> TraceLine:
             target=_node(g.get("target"), f"{at}.target"),
             state=str(g.get("state") or ""),
             active=active,
+            awareness=None if g.get("awareness") is None
+            else _number(g["awareness"], f"{at}.awareness"),
+            role=str(g.get("role") or ""),
         ))
     events_raw = record.get("events", [])
     if not isinstance(events_raw, list):
@@ -234,6 +248,7 @@ def parse_line(record: Any, where: str) -> TraceLine:
         player_node=_node(player.get("node"), f"{where}: player.node"),
         guards=tuple(guards),
         events=events,
+        phase=str(record.get("phase") or ""),
     )
 
 

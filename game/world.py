@@ -26,6 +26,7 @@ from .metrics import Counters, world_metrics
 from .schema import check_level
 from .senses import RANGE_EPS, Senses
 from .spawns import guard_spawn_nodes, start_node
+from .team import TeamRules
 from .zones import ZoneMap
 
 SCENARIOS = ("capture", "fixed")
@@ -90,11 +91,12 @@ class World(PlayerActions):
         self.seen_by: tuple[int, ...] = ()
         self.sprinting = False
         self._sprinted = False
+        self.player_moved = False
         self.player_input: tuple[float, float] | None = None
         self.on_tick: Callable[[World], None] | None = None
         self.m: Counters = Counters.for_nodes(self.graph.n)
 
-        guard_speed = float(w["guard_speed"])
+        guard_speed = self.guard_speed = float(w["guard_speed"])
         player_speed = float(w["player_speed"]) * float(s["player_speed_scale"])
         spawn_nodes = guard_spawn_nodes(self.graph, level, spawn_rng, int(w["guards"]),
                                         str(w["spawns"]))
@@ -118,6 +120,8 @@ class World(PlayerActions):
         self.init_actions(level, raining=self.stimulus_params.raining)
         for factory in stimuli:
             self.stimuli.add(factory())
+        # Beyond the paper (game.team): graded perception, alert phases, radio, roles.
+        self.team = TeamRules.build(config, len(self.guards), self.stimuli)
         self.stimuli.refresh()
         self._watched = self.stimuli.marked_nodes()
 
@@ -211,7 +215,8 @@ class World(PlayerActions):
             node = self.graph.node_near(*agent.pos, agent.node)
             if node != agent.node:
                 self._enter_node(agent, node)
-        if sprint and self.player.pos != before[-1]:
+        self.player_moved = self.player.pos != before[-1]
+        if sprint and self.player_moved:
             self._sprinted = True  # footsteps: the player moved while sprinting this tick
 
         self._sense()
@@ -235,7 +240,8 @@ class World(PlayerActions):
     def _sense(self) -> None:
         """Vision, attack damage, distance and detection metrics for the current positions."""
         ppos = self.player.pos
-        self.seen_by = tuple(i for i, g in enumerate(self.guards) if self.sees(g, ppos))
+        self.seen_by = self.team.detect(
+            self, tuple(i for i, g in enumerate(self.guards) if self.sees(g, ppos)))
         if self.seen_by:
             self.sighting = self.player.node
             if self.m.first_detect_time is None:
@@ -263,9 +269,11 @@ class World(PlayerActions):
         if self._sprinted:
             self.events.append(Event("sprint", self.player.node, self.t))
             self._sprinted = False
+        self.team.before_tick(self)
         self.tick_events = self.events
         view = self.view()
         self.stimuli.tick(view, dt)  # before the guard AI's tick, so FSM reacts to new layers
+        self.team.after_stimuli(self)
         self.guard_ai.tick(view, dt)
         self._watched = self.stimuli.marked_nodes()
         self.events = []

@@ -50,6 +50,7 @@ from navmesh.level import cached_level, load_level
 
 from .executors import check_workers, process_pool
 from .filenames import output_path
+from .mechanics_ai import AI_EXPECTED, AI_MECHANICS
 from .progress import Progress
 from .stats import mean_or_nan, percentile_ci
 
@@ -303,6 +304,7 @@ MECHANICS: dict[str, Callable[[str, str, int], Measures]] = {
     "dark": dark,
     "concealment": concealment,
     "rain": rain,
+    **AI_MECHANICS,  # beyond the paper: perception, alert, radio, roles (headless/mechanics_ai.py)
 }
 
 #: the direction each measure should move when the mechanic is on: +1 up, -1 down
@@ -319,6 +321,7 @@ EXPECTED: dict[str, int] = {
     "concealment: time to first detection, s (censored at 30)": +1,
     "concealment: distance of the guard at first detection, units": -1,
     "rain: share of footsteps 1-8 hops away that draw a guard": -1,
+    **AI_EXPECTED,
 }
 
 Row = tuple[str, int, str, float]  # measure, seed, arm, value

@@ -390,8 +390,16 @@ class Renderer:
         tip = (center[0] + hx * radius * 1.7, center[1] + hy * radius * 1.7)
         pygame.draw.line(surface, (20, 20, 20), center, tip, 2)
         if guard.state:
-            label = self._text(guard.state, self.small, TEXT)
+            text = f"{guard.state} · {guard.role}" if guard.role else guard.state
+            label = self._text(text, self.small, TEXT)
             surface.blit(label, (center[0] - label.get_width() / 2, center[1] + radius + 1))
+        if guard.awareness is not None:  # graded perception: a meter above the guard
+            frac = max(0.0, min(1.0, guard.awareness))
+            meter = pygame.Rect(round(center[0] - radius), round(center[1] - radius - 7),
+                                round(2 * radius), 4)
+            pygame.draw.rect(surface, (40, 40, 40), meter)
+            pygame.draw.rect(surface, BAD if frac >= 1.0 else WARN,
+                             (meter.x, meter.y, round(meter.w * frac), meter.h))
 
     def _draw_player(self, surface: pygame.Surface, scene: Scene) -> None:
         s = self.layout.scale
@@ -459,6 +467,9 @@ class Renderer:
             (f"{scene.mode} · {scene.abstraction}" if scene.mode == "replay"
              else f"guards {scene.mode} · {scene.abstraction}", TEXT),
         ]
+        if scene.phase:
+            items.append((f"team {scene.phase}", BAD if scene.phase == "alert" else
+                          WARN if scene.phase in ("suspicious", "search") else TEXT))
         if scene.captures and scene.status == "playing":
             items.append((f"captures {scene.captures}", WARN))
         if scene.rain is not None:

@@ -267,7 +267,7 @@ class ReplayViewer(FrameLoop):
                 pos=pos, heading=heading, active=record.active, sees_player=record.sees_player,
                 state=record.state if record.active else "down",
                 cone=self.builder.cone(pos, heading, reach) if record.active else np.zeros((0, 2)),
-                target=target,
+                target=target, awareness=record.awareness, role=record.role,
             ))
         seen = tuple(k for k, g in enumerate(line.guards) if g.sees_player)
         return Scene(
@@ -279,6 +279,7 @@ class ReplayViewer(FrameLoop):
             reach=reach, attack_range=self.attack_range, agent_radius=self.radius,
             events=line.events,
             markers=self.graph.positions[list(line.markers)].reshape(-1, 2),
+            phase=line.phase,
         )
 
     def frame(self, elapsed: float) -> None:
