@@ -10,6 +10,8 @@ Everything is written into DIR next to ``results.sqlite``:
 * ``heatmaps/{level}_{abstraction}_{mode}_{visit,attack}.{csv,png}`` — summed per-node
   visit and attack counts;
 * ``aggregate_{abstraction}.png`` — the paper's "Aggregated performance" bar figure;
+* ``factors.{md,csv}``, ``factors/*/table.md``, ``factor_*.png`` — only for a design with
+  factors (:mod:`headless.factor_report`);
 * ``failed.csv`` — only when some trial failed;
 * ``README.md`` — what the files are and where our metrics differ from the paper's.
 
@@ -29,6 +31,7 @@ import sys
 from pathlib import Path
 
 from .errors import UserError
+from .factor_report import write_factor_report
 from .figures import write_aggregate
 from .heatmaps import HeatSums, write_heatmaps
 from .readme import readme
@@ -98,6 +101,8 @@ def write_report(directory: str | Path, *, figures: bool = True) -> list[Path]:
     elif failed_path.exists():
         failed_path.unlink()
 
+    written += write_factor_report(trials, directory, design.get("abstractions"),
+                                   figures=figures)
     written += write_heatmaps(heat, directory, figures=figures)
     if figures:
         written += write_aggregate(rows, directory)

@@ -6,7 +6,8 @@ positions (the navmesh funnel path, so nobody walks through a wall corner), at c
 speed; a jump longer than any agent can walk in that time (a respawn) is shown as a jump.
 
 The lines carry no level name, so ``--level`` is required unless a line has a ``level``
-key. The node numbers refer to the grid or the partition graph; which one is detected from
+key. ``stealth replay DIR --trial KEY`` re-simulates a stored trial into a temporary trace
+first (:func:`replay_trial`). The node numbers refer to the grid or the partition graph; which one is detected from
 the positions (``--abstraction`` overrides).
 """
 
@@ -14,6 +15,7 @@ from __future__ import annotations
 
 import argparse
 import math
+import tempfile
 from collections.abc import Sequence
 from pathlib import Path
 
@@ -23,6 +25,7 @@ from game.agents import max_agent_speed
 from game.front.render import DrawOptions, FrameLoop, Renderer, default_window_size, init_pygame, pygame
 from game.scene import GuardDrawing, PlayerDrawing, Scene, SceneBuilder
 from game.trace import GuardRecord, Trace, TraceError, TraceLine, load_trace, parse_line
+from game.trial import TrialSpec
 from game.zones import ZoneMap
 from navmesh.graph import NodeGraph
 from navmesh.level import Level
@@ -355,7 +358,22 @@ def cmd_replay(args: argparse.Namespace) -> int:
     return 0
 
 
+def replay_trial(spec: TrialSpec, args: argparse.Namespace) -> int:
+    """``stealth replay DIR --trial KEY``: re-simulate the trial ``spec`` into a temporary
+    trace and play that back (the caller looks the spec up in the store)."""
+    from game.trial import run_trial
+
+    with tempfile.TemporaryDirectory(prefix="stealth-replay-") as folder:
+        path = Path(folder) / "trial.jsonl"
+        with path.open("w", encoding="utf-8") as handle:
+            run_trial(spec, trace=handle)
+        args.trace, args.level = str(path), spec.level
+        args.abstraction, args.scenario = spec.abstraction, spec.scenario
+        return cmd_replay(args)
+
+
 __all__: Sequence[str] = [
     "GuardRecord", "Playback", "ReplayViewer", "Trace", "TraceError", "TraceLine", "cmd_replay",
+    "replay_trial",
     "detect_abstraction", "load_trace", "parse_line",
 ]
