@@ -32,7 +32,7 @@ import warnings
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import Any, Literal
 
 from game.config_file import read_config_file, write_config_file
 from game.errors import ConfigError
@@ -47,6 +47,8 @@ from .presets import Preset, check_setting, parse_preset
 __all__ = ["Param", "TuneSpec", "cmd_tune", "load_tune_spec", "run_study"]
 
 STUDY_NAME = "stealth-tune"
+STUDIES_DIR = Path(__file__).resolve().parent / "studies"
+"""Bundled tune specs (``stealth tune paper-calibrate``)."""
 _TUNE_KEYS = ("search", "objective", "seeds_train", "seeds_test", "sampler_seed")
 
 
@@ -78,7 +80,7 @@ class TuneSpec:
     text: str
     preset: Preset
     params: tuple[Param, ...]
-    direction: str
+    direction: Literal["maximize", "minimize"]
     objective: Expression | None
     constraints: tuple[Expression, ...]
     target: Target | None
@@ -145,6 +147,8 @@ def _param(key: str, table: Any, src: str, factors: set[str]) -> Param:
 def load_tune_spec(path: str | Path, extra: Mapping[str, Any] | None = None) -> TuneSpec:
     """Read and validate a tune spec; ``extra`` (a ``--config`` file) goes over its ``[set]``."""
     path = Path(path)
+    if not path.is_file() and (STUDIES_DIR / f"{path}.toml").is_file():
+        path = STUDIES_DIR / f"{path}.toml"  # a bundled study by name
     src = str(path)
     try:
         text = path.read_text(encoding="utf-8")
@@ -282,8 +286,8 @@ def run_study(spec: TuneSpec, out: Path, trials: int, *, workers: int | None = N
                 raise
             value, cons, facts = spec.score(rows)
             trial.set_user_attr("constraints", cons)
-            for number, held in enumerate(cons):  # <= 0 holds; TPE prefers feasible trials
-                trial.set_constraint(f"c{number}", held)
+            for number, amount in enumerate(cons):  # <= 0 holds; TPE prefers feasible trials
+                trial.set_constraint(f"c{number}", amount)
             for name, fact in facts.items():
                 trial.set_user_attr(name, fact)
             if not math.isfinite(value):
@@ -303,8 +307,9 @@ def run_study(spec: TuneSpec, out: Path, trials: int, *, workers: int | None = N
             else:
                 held = range(spec.seeds_train, spec.seeds_train + spec.seeds_test)
                 rows = evaluate(executor, spec.specs(best.params, held), parallelism)
-                value, cons, facts = spec.score(rows)
-                test = {"trial": best.number, "value": value, "constraints": cons, **facts}
+                held_value, held_cons, held_facts = spec.score(rows)
+                test = {"trial": best.number, "value": held_value, "constraints": held_cons,
+                        **held_facts}
                 study.set_user_attr("test", test)
     finally:
         if executor is not None:
