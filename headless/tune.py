@@ -39,7 +39,8 @@ from game.errors import ConfigError
 from game.trial import TrialSpec
 
 from .errors import SweepError, UserError
-from .executors import InlineExecutor, connect_dask, process_pool, run_batch, shutdown
+from .executors import (InlineExecutor, connect_dask, process_pool, run_batch, shutdown,
+                        terminate)
 from .expr import Expression, parse_constraint, parse_expression
 from .objective import Target, as_trials, check_names, load_target, lookup_for
 from .presets import Preset, check_setting, parse_preset
@@ -311,6 +312,11 @@ def run_study(spec: TuneSpec, out: Path, trials: int, *, workers: int | None = N
                 test = {"trial": best.number, "value": held_value, "constraints": held_cons,
                         **held_facts}
                 study.set_user_attr("test", test)
+    except KeyboardInterrupt:
+        if executor is not None:
+            terminate(executor)  # the pool's workers ignore Ctrl-C: end them now
+            executor = None
+        raise
     finally:
         if executor is not None:
             shutdown(executor)

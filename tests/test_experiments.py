@@ -3,13 +3,16 @@
 from __future__ import annotations
 
 import json
+import os
 import sqlite3
 from pathlib import Path
 from typing import Any
 
 import pytest
 
-from game.trial import trial_rngs
+os.environ.setdefault("SDL_VIDEODRIVER", "dummy")  # replay --trial, before pygame loads
+
+from game.trial import trial_rngs  # noqa: E402
 from headless.cli import main
 from headless.errors import UserError
 from headless.expr import parse_constraint, parse_expression
@@ -184,6 +187,11 @@ def test_sim_from_reproduces_stored_rows_exactly(tmp_path: Path,
     assert main(["sim", "--from", str(out), "--trial", "nope"]) == 2
     assert "no finished trial with this key" in capsys.readouterr().err
     assert main(["sim", "maze", "--from", str(out), "--trial", stored[0]["key"]]) == 2
+    capsys.readouterr()
+    shot = tmp_path / "shot.png"
+    assert main(["replay", str(out), "--trial", stored[-1]["key"], "--frames", "3",
+                 "--screenshot", str(shot)]) == 0
+    assert shot.stat().st_size > 0
 
 
 # ------------------------------------------------------------------------ expressions
