@@ -44,6 +44,13 @@ class TrialSpec:
     root_seed: int = 0
     #: extra stimuli: ``"path/to/file.py:Name"`` or installed entry-point names (docs/mechanics.md)
     stimuli: tuple[str, ...] = ()
+    #: this trial's values of the design's factors (SPEC §10), applied after ``overrides``
+    factors: tuple[tuple[str, Any], ...] = ()
+
+    @property
+    def settings(self) -> dict[str, Any]:
+        """Every config override the trial runs with: the fixed ``[set]`` ones, then its factors."""
+        return {**dict(self.overrides), **dict(self.factors)}
 
     @property
     def key(self) -> str:
@@ -53,6 +60,8 @@ class TrialSpec:
                  str(self.seed), str(self.root_seed), extra]
         if self.stimuli:  # only then, so the keys of trials without plugins do not change
             parts.append("stimuli=" + "+".join(self.stimuli))
+        if self.factors:  # likewise: a design without factors keeps today's keys
+            parts.append("factors=" + ",".join(f"{k}={v}" for k, v in self.factors))
         return "/".join(parts)
 
 
@@ -61,11 +70,13 @@ def trial_rngs(spec: TrialSpec, level_name: str) -> Generators:
 
     The spawn generator depends on (root, level, abstraction, seed) only, so every guard
     mode and player policy of one seed starts from the same positions (common random
-    numbers: comparisons between modes are paired). The controllers' generators depend on
-    the whole identity.
+    numbers: comparisons between modes are paired), and so does every level of a factor.
+    The controllers' generators depend on the whole identity, factor values included (a
+    trial without factors draws exactly what it drew before factors existed).
     """
     base = [spec.root_seed, _tag(level_name), _tag(spec.abstraction), spec.seed]
     who = [_tag(spec.guards), _tag(spec.player), _tag(spec.scenario)]
+    who += [_tag(f"{k}={v!r}") for k, v in spec.factors]
     seqs = [
         np.random.SeedSequence(base + [_tag("spawn")]),
         np.random.SeedSequence(base + who + [_tag("guards")]),
@@ -77,7 +88,7 @@ def trial_rngs(spec: TrialSpec, level_name: str) -> Generators:
 
 def make_world(spec: TrialSpec, config: Config | None = None, **world_kwargs: Any) -> World:
     """Build the world of a trial (level and graph are cached per process)."""
-    config = config or Config.load(dict(spec.overrides))
+    config = config or Config.load(spec.settings)
     if spec.stimuli:  # first: loading a plugin registers the zone kinds its level may use
         world_kwargs.setdefault("stimuli", [load_stimulus(s) for s in spec.stimuli])
     level = cached_level(spec.level)
@@ -111,7 +122,7 @@ def run_trial(
     With ``trace`` every AI tick (and t = 0) is written as one JSON line; with ``explain``
     those lines also carry the first guard's last decision explained (PF only).
     """
-    config = Config.load(dict(spec.overrides))
+    config = Config.load(spec.settings)
     started = time.perf_counter()
     world = make_world(spec, config)
     writer = attach_trace(world, trace, explain=explain) if trace is not None else None
@@ -119,8 +130,9 @@ def run_trial(
     if writer is not None:
         writer.finish(world)
     return {
-        **{k: v for k, v in asdict(spec).items() if k not in ("overrides", "stimuli")},
+        **{k: v for k, v in asdict(spec).items() if k not in ("overrides", "stimuli", "factors")},
         **({"stimuli": list(spec.stimuli)} if spec.stimuli else {}),
+        **({"factors": dict(spec.factors)} if spec.factors else {}),
         "level": world.level.name,
         "overrides": dict(spec.overrides),
         "config_hash": config.hash(),

@@ -18,7 +18,7 @@ import os
 import sqlite3
 import sys
 import traceback
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from typing import Any, NoReturn
 
 from ai import GUARD_MODES, PLAYER_POLICIES
@@ -154,21 +154,31 @@ def cmd_path(args: argparse.Namespace) -> int:
 
 
 # ---------------------------------------------------------------------- sim
-def _overrides(items: Sequence[str], level: Any) -> tuple[tuple[str, Any], ...]:
-    """The ``--set`` pairs, every key and value checked now, also against the level
-    (one-line ConfigError before any file is written)."""
+def _overrides(items: Sequence[str], level: Any, base: Mapping[str, Any] | None = None
+               ) -> tuple[tuple[str, Any], ...]:
+    """The ``--config`` file's settings (``base``) overridden by the ``--set`` pairs, every
+    key and value checked now, also against the level (one-line ConfigError before any
+    file is written)."""
     from game.config import Config, parse_overrides
     from game.schema import check_level
 
-    check_level(Config.load(items), level)
-    return tuple(parse_overrides(items))
+    settings = {**(base or {}), **dict(parse_overrides(items))}
+    check_level(Config.load(settings), level)
+    return tuple(settings.items())
 
 
 def cmd_sim(args: argparse.Namespace) -> int:
     from ai.stimuli import load_stimulus
+    from game.config_file import read_config_file
     from game.trial import TrialSpec, run_trial, sim_document
     from navmesh.level import load_level
 
+    if args.from_dir is not None or args.trial is not None:
+        from .reproduce import cmd_sim_from
+
+        return cmd_sim_from(args)
+    if args.level is None:
+        raise UsageError("sim: a LEVEL is required (or --from DIR --trial KEY)")
     for plugin in args.stimulus:  # before the level: a plugin may declare its zone kinds
         load_stimulus(plugin)  # a bad plugin fails here with its one-line message
     level = load_level(args.level)  # a bad level fails here with its one-line message
@@ -179,7 +189,8 @@ def cmd_sim(args: argparse.Namespace) -> int:
         player=args.player,
         scenario=args.scenario,
         seed=args.seed,
-        overrides=_overrides(args.set, level),
+        overrides=_overrides(args.set, level,
+                             read_config_file(args.config) if args.config else {}),
         stimuli=tuple(args.stimulus),
     )
     if args.trace:
@@ -248,15 +259,28 @@ def _cmd_mechanics(args: argparse.Namespace) -> int:
 
 
 def _cmd_play(args: argparse.Namespace) -> int:
+    from game.config_file import read_config_file
     from game.front.play import cmd_play
 
+    if args.config:  # the file's overrides first, so --set still wins
+        args.set = [f"{k}={v}" for k, v in read_config_file(args.config).items()] + args.set
     return cmd_play(args)
 
 
 def _cmd_replay(args: argparse.Namespace) -> int:
-    from game.front.replay import cmd_replay
+    from game.front.replay import cmd_replay, replay_trial
 
+    if args.trial is not None:
+        from .reproduce import stored_spec
+
+        return replay_trial(stored_spec(args.trace, args.trial), args)
     return cmd_replay(args)
+
+
+def _cmd_tune(args: argparse.Namespace) -> int:
+    from .tune import cmd_tune
+
+    return cmd_tune(args)
 
 
 # ---------------------------------------------------------------------- parser
@@ -331,6 +355,11 @@ def build_parser() -> argparse.ArgumentParser:
                        help="override a config value (game/defaults.toml key), e.g. "
                             "--set world.view_range=6; repeatable (default: none)")
 
+    def add_config(p: argparse.ArgumentParser) -> None:
+        p.add_argument("--config", default=None, metavar="FILE.toml",
+                       help="a TOML of config overrides in the dotted-key form of a preset's "
+                            "[set], e.g. the best.toml of stealth tune (default: none)")
+
     p = command("levels", "paper Table 1 figures of levels")
     p.add_argument("level", nargs="*", default=[],
                    help="level files or bundled names (default: every bundled level)")
@@ -352,7 +381,13 @@ def build_parser() -> argparse.ArgumentParser:
     p.set_defaults(func=cmd_path)
 
     p = command("sim", "run one trial and print its metrics")
-    p.add_argument("level", help="level file or bundled name")
+    p.add_argument("level", nargs="?", default=None,
+                   help="level file or bundled name (not with --from)")
+    p.add_argument("--from", dest="from_dir", default=None, metavar="DIR",
+                   help="re-run a stored trial of the results directory DIR (with --trial)")
+    p.add_argument("--trial", default=None, metavar="KEY",
+                   help="key of the stored trial to re-run (the key column of trials.csv)")
+    add_config(p)
     p.add_argument("--guards", choices=modes, default="pf", help="guard mode")
     p.add_argument("--player", choices=policies, default="maxmin", help="player policy")
     p.add_argument("--abstraction", choices=abstractions, default="grid",
@@ -394,7 +429,25 @@ def build_parser() -> argparse.ArgumentParser:
                    help="worker processes, 1 = in-process (default: one per CPU)")
     p.add_argument("--scheduler", default=None,
                    help="address of a Dask scheduler to run the trials on, cluster extra (default: local processes)")
+    p.add_argument("--seeds", type=int, default=None, metavar="N",
+                   help="run seeds 0..N-1 instead of the preset's (more seeds grow a stored "
+                        "design: only the missing trials run)")
+    add_config(p)
     p.set_defaults(func=_cmd_run)
+
+    p = command("tune", "search a parameter space with Optuna (resumable study)")
+    p.add_argument("spec", metavar="SPEC.toml",
+                   help="the design (a preset) with [search], [objective], seeds_train, "
+                        "seeds_test (docs/experiments.md)")
+    p.add_argument("--out", required=True, help="study directory (resumed when it exists)")
+    p.add_argument("--trials", type=int, default=20,
+                   help="Optuna trials the study should have in total")
+    p.add_argument("--workers", type=int, default=None,
+                   help="worker processes, 1 = in-process (default: one per CPU)")
+    p.add_argument("--scheduler", default=None,
+                   help="address of a Dask scheduler to run the trials on (default: local processes)")
+    add_config(p)
+    p.set_defaults(func=_cmd_tune)
 
     p = command("report", "tables, CSVs and figures of a results directory")
     p.add_argument("dir", help="results directory written by stealth run")
@@ -416,6 +469,7 @@ def build_parser() -> argparse.ArgumentParser:
                    help=f"initial field overlay: {', '.join(OVERLAYS)}")
     p.add_argument("--seed", type=_seed, default=0, help="seed of the guards' decisions")
     add_set(p)
+    add_config(p)
     p.add_argument("--scenario", choices=scenarios, default="capture",
                    help="capture: game over at HP 0; fixed: respawn, play the full duration")
     p.add_argument("--mesh", action="store_true", help="start with the grid / navmesh shown")
@@ -423,8 +477,10 @@ def build_parser() -> argparse.ArgumentParser:
     add_stimulus(p, "add a stimulus to the game")
     p.set_defaults(func=_cmd_play)
 
-    p = command("replay", "replay a trace written by stealth sim --trace")
-    p.add_argument("trace", help="trace file (JSON lines)")
+    p = command("replay", "replay a trace written by stealth sim --trace, or a stored trial")
+    p.add_argument("trace", help="trace file (JSON lines), or a results directory with --trial")
+    p.add_argument("--trial", default=None, metavar="KEY",
+                   help="re-simulate and show the stored trial KEY of the results directory")
     p.add_argument("--level", default=None, help="level of the trace (default: the one the trace names)")
     p.add_argument("--frames", type=int, default=None,
                    help="stop after N frames (default: until Esc)")

@@ -39,7 +39,7 @@ def run_one(spec: TrialSpec) -> dict[str, Any]:
             "level": spec.level, "abstraction": spec.abstraction, "guards": spec.guards,
             "player": spec.player, "scenario": spec.scenario, "seed": spec.seed,
             "root_seed": spec.root_seed, "overrides": dict(spec.overrides),
-            "error": f"{type(error).__name__}: {error}\n{traceback.format_exc(limit=-8)}"[:8000],
+            "factors": dict(spec.factors), "error": f"{type(error).__name__}: {error}\n{traceback.format_exc(limit=-8)}"[:8000],
         }
     row["key"] = spec.key
     row["level_ref"] = spec.level

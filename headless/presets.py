@@ -2,8 +2,9 @@
 
 A **preset** is a TOML file (``headless/presets/NAME.toml`` or the user's own) naming the
 levels, abstractions, guard modes, player policies, scenarios and seeds of a full factorial
-design, an optional ``root_seed``, an optional ``[set]`` table of config overrides and a
-one-line ``description``. :func:`load_preset` turns one into a :class:`Preset` whose
+design, an optional ``root_seed``, an optional ``[set]`` table of config overrides, an
+optional ``[factors]`` table (a config key → the list of values the design crosses, SPEC
+§10) and a one-line ``description``. :func:`load_preset` turns one into a :class:`Preset` whose
 :meth:`Preset.specs` lists every trial in the sweep's order; every mistake is a one-line
 :class:`~headless.errors.PresetError` naming the file and field.
 
@@ -16,7 +17,7 @@ from __future__ import annotations
 import math
 import tomllib
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
@@ -26,8 +27,8 @@ from navmesh.files import FileRefused, read_regular
 from .errors import PresetError
 
 __all__ = [
-    "MAX_PRESET_BYTES", "MAX_TRIALS", "PRESETS_DIR", "Preset", "bundled_preset_names", "bundled_presets", "load_preset",
-    "parse_preset",
+    "MAX_PRESET_BYTES", "MAX_TRIALS", "PRESETS_DIR", "Preset", "bundled_preset_names",
+    "bundled_presets", "check_setting", "load_preset", "parse_preset",
 ]
 
 PRESETS_DIR = Path(__file__).resolve().parent / "presets"
@@ -40,7 +41,7 @@ MAX_PRESET_BYTES = 2**20
 """Largest preset file read (1 MiB)."""
 
 _LIST_FIELDS = ("levels", "abstractions", "guards", "players", "scenarios")
-_ALLOWED_KEYS = (*_LIST_FIELDS, "seeds", "root_seed", "set", "stimuli", "description")
+_ALLOWED_KEYS = (*_LIST_FIELDS, "seeds", "root_seed", "set", "factors", "stimuli", "description")
 
 
 @dataclass(frozen=True)
@@ -65,6 +66,8 @@ class Preset:
     config: Mapping[str, Any] = field(default_factory=dict)
     #: plugin stimuli of every trial (``stimuli = ["file.py:Name"]``; paths made absolute)
     stimuli: tuple[str, ...] = ()
+    #: ``(key, levels)`` of every factor, sorted by key (the design crosses all of them)
+    factors: tuple[tuple[str, tuple[Any, ...]], ...] = ()
 
     @property
     def n_trials(self) -> int:
@@ -72,21 +75,42 @@ class Preset:
         n = len(self.seeds)
         for name in _LIST_FIELDS:
             n *= len(getattr(self, name))
+        for _, levels in self.factors:
+            n *= len(levels)
         return n
 
+    def factor_points(self) -> list[tuple[tuple[str, Any], ...]]:
+        """Every combination of factor levels (one empty combination without factors)."""
+        points: list[tuple[tuple[str, Any], ...]] = [()]
+        for key, levels in self.factors:
+            points = [(*point, (key, value)) for point in points for value in levels]
+        return points
+
     def specs(self) -> list[TrialSpec]:
-        """Every trial of the design, in the sweep's deterministic order (seeds outermost)."""
+        """Every trial of the design, in the sweep's deterministic order (seeds outermost,
+        factor levels innermost)."""
+        points = self.factor_points()
         return [
             TrialSpec(level=level, abstraction=abstraction, guards=guards, player=player,
                       scenario=scenario, seed=seed, overrides=self.overrides,
-                      root_seed=self.root_seed, stimuli=self.stimuli)
+                      root_seed=self.root_seed, stimuli=self.stimuli, factors=point)
             for seed in self.seeds
             for level in self.levels
             for abstraction in self.abstractions
             for guards in self.guards
             for player in self.players
             for scenario in self.scenarios
+            for point in points
         ]
+
+    def with_seeds(self, count: int) -> Preset:
+        """The same design with seeds ``0 … count-1`` (``stealth run --seeds N``)."""
+        if count < 1:
+            raise PresetError(f"--seeds: must be at least 1, got {count}")
+        if count * (self.n_trials // len(self.seeds)) > MAX_TRIALS:
+            raise PresetError(f"--seeds {count}: the design would have more than "
+                              f"{MAX_TRIALS} trials")
+        return replace(self, seeds=tuple(range(count)))
 
     def design(self) -> dict[str, Any]:
         """The design as JSON-able data (stored in the results' ``meta`` table)."""
@@ -100,8 +124,9 @@ class Preset:
             "seeds": list(self.seeds),
             "root_seed": self.root_seed,
             "set": {k: v for k, v in self.overrides},
-            # only when there are any, so the designs of existing stores stay equal
+            # each only when there are any, so the designs of existing stores stay equal
             **({"stimuli": list(self.stimuli)} if self.stimuli else {}),
+            **({"factors": {k: list(v) for k, v in self.factors}} if self.factors else {}),
         }
 
 
@@ -131,12 +156,13 @@ def _preset_path(name_or_path: str) -> tuple[Path, str]:
     raise PresetError(f"{name_or_path}: no such preset file")
 
 
-def load_preset(name_or_path: str) -> Preset:
+def load_preset(name_or_path: str, extra: Mapping[str, Any] | None = None) -> Preset:
     """Load and fully validate a bundled preset (by name) or a preset file (by path).
 
     Every problem raises :class:`~headless.errors.PresetError` with one line naming the file and
     the field: unknown keys, modes, policies, abstractions or scenarios, levels that do not
-    load, empty lists or no seeds, bad ``[set]`` overrides.
+    load, empty lists or no seeds, bad ``[set]`` overrides or factors. ``extra`` overrides
+    (a ``--config`` file's) are applied after the preset's ``[set]``.
     """
     path, src = _preset_path(name_or_path)
     try:
@@ -149,7 +175,8 @@ def load_preset(name_or_path: str) -> Preset:
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as error:
         raise PresetError(f"{src}: toml: not valid TOML ({error})") from None
-    return parse_preset(data, src, name=path.stem, text=text, base=path.resolve().parent)
+    return parse_preset(data, src, name=path.stem, text=text, base=path.resolve().parent,
+                        extra=extra)
 
 
 def _fail(src: str, field: str, problem: str) -> PresetError:
@@ -164,6 +191,45 @@ def _flatten(table: Mapping[str, Any], prefix: str = "") -> dict[str, Any]:
         else:
             flat[f"{prefix}{key}"] = value
     return flat
+
+
+def check_setting(key: str, value: Any) -> Any:
+    """A config value as the trials will run with it, or :class:`~game.errors.ConfigError`.
+
+    The one check every ``[set]`` value, factor level and ``stealth tune`` search bound goes
+    through: the key must exist and the value lie in its declared range
+    (:func:`game.config.check_value`, through ``Config.load``).
+    """
+    from game.config import Config
+
+    return Config.load({key: value})[key]
+
+
+def _factors(data: Mapping[str, Any], src: str, fixed: Mapping[str, Any],
+             ) -> tuple[tuple[str, tuple[Any, ...]], ...]:
+    """The ``[factors]`` table: each dotted config key → a non-empty list of distinct values."""
+    from game.errors import ConfigError
+
+    table = data.get("factors", {})
+    if not isinstance(table, Mapping):
+        raise _fail(src, "factors", "expected a table: config key = [values]")
+    factors = []
+    for key, values in sorted(_flatten(table).items()):
+        where = f"factors.{key}"
+        if key in fixed:
+            raise _fail(src, where, "is also in [set]: a key is either fixed or a factor")
+        if not isinstance(values, list) or not values:
+            raise _fail(src, where, f"expected a non-empty list of values, got {values!r}")
+        levels = []
+        for value in values:
+            try:
+                levels.append(check_setting(key, value))
+            except ConfigError as error:
+                raise _fail(src, where, str(error)) from None
+        if len(set(map(repr, levels))) != len(levels):
+            raise _fail(src, where, "a value is listed twice")
+        factors.append((key, tuple(levels)))
+    return tuple(factors)
 
 
 def _names(data: Mapping[str, Any], key: str, src: str, allowed: Sequence[str] | None) -> list[str]:
@@ -260,9 +326,10 @@ def parse_preset(
     name: str = "preset",
     text: str = "",
     base: Path | None = None,
+    extra: Mapping[str, Any] | None = None,
 ) -> Preset:
     """Validate decoded preset data (see :func:`load_preset`); relative level paths are
-    resolved against ``base`` (the preset file's folder)."""
+    resolved against ``base`` (the preset file's folder); ``extra`` overrides the ``[set]``."""
     from ai import GUARD_MODES, PLAYER_POLICIES, guard_mode, player_policy
     from game.config import Config
     from game.errors import ConfigError
@@ -297,7 +364,7 @@ def parse_preset(
     overrides_table = data.get("set", {})
     if not isinstance(overrides_table, Mapping):
         raise _fail(src, "set", "expected a table of config overrides (dotted keys)")
-    flat = _flatten(overrides_table)
+    flat = {**_flatten(overrides_table), **(extra or {})}
     try:
         config = Config.load(flat)
     except ConfigError as error:
@@ -305,6 +372,11 @@ def parse_preset(
     # The values as the config coerced them (10 -> 10.0 for a float key), so equal settings
     # written differently give equal trial keys.
     overrides = tuple((key, config[key]) for key in sorted(flat))
+    factors = _factors(data, src, flat)
+    n_trials *= math.prod(len(levels) for _, levels in factors)
+    if n_trials > MAX_TRIALS:
+        raise _fail(src, "factors", f"the design has {n_trials} trials, more than the limit of "
+                                    f"{MAX_TRIALS}; use fewer factor levels or seeds")
 
     for mode in guards:
         try:
@@ -352,6 +424,7 @@ def parse_preset(
         scenarios=tuple(scenarios), seeds=seeds, root_seed=root_seed, overrides=overrides,
         description=description, config_hash=config.hash(), config=config.as_dict(),
         stimuli=stimuli,
+        factors=factors,
     )
 
 

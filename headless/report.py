@@ -12,6 +12,8 @@ Everything is written into DIR next to ``results.sqlite``:
   side by side on one colour scale;
 * ``aggregate_{abstraction}.{png,svg}`` — the paper's "Aggregated performance" bar figure,
   with the paper's values overlaid when the design is the paper's;
+* ``factors.{md,csv}``, ``factors/*/table.md``, ``factor_*.png`` — only for a design with
+  factors (:mod:`headless.factor_report`);
 * ``failed.csv`` — only when some trial failed;
 * ``README.md`` — what the files are and where our metrics differ from the paper's.
 
@@ -33,6 +35,7 @@ from pathlib import Path
 from ai.stimuli import load_stimulus
 
 from .errors import UserError
+from .factor_report import write_factor_report
 from .figures import FORMATS, write_aggregate
 from .heatmaps import HeatSums, figure_count, write_heatmaps
 from .paper import is_paper_design, paper_table3
@@ -107,6 +110,8 @@ def write_report(directory: str | Path, *, figures: bool = True,
     elif failed_path.exists():
         failed_path.unlink()
 
+    written += write_factor_report(trials, directory, design.get("abstractions"),
+                                   figures=figures)
     abstractions = len(dict.fromkeys(r["abstraction"] for r in rows))
     bar = Progress(figure_count(heat) + abstractions, sys.stderr,
                    enabled=progress and figures, unit="figures")

@@ -7,6 +7,7 @@
   opening an older store adds the columns of metrics registered since), the per-node ``visits`` and
   ``attacks`` lists (zlib-compressed JSON, ``json.loads(zlib.decompress(blob))``), the error
   text (``NULL`` on success), the wall time and when it finished;
+* the trial's factor values (``factors``, JSON; ``{}`` without factors, SPEC §10);
 * ``meta`` — key/value text: the preset (its TOML text and its expanded design as JSON),
   the config hash and ``level_digests`` (the SHA-256 of every level file, by level
   reference), so ``stealth report`` knows the design and a resumed sweep can check that it
@@ -74,7 +75,8 @@ CREATE TABLE IF NOT EXISTS trials (
     attacks BLOB,
     error TEXT,
     wall_time REAL,
-    finished_at TEXT NOT NULL
+    finished_at TEXT NOT NULL,
+    factors TEXT
 );
 CREATE TABLE IF NOT EXISTS meta (
     key TEXT PRIMARY KEY,
@@ -85,7 +87,7 @@ CREATE TABLE IF NOT EXISTS meta (
 _HEAD: tuple[str, ...] = ("key", "level", "level_ref", "abstraction", "guards", "player",
                           "scenario", "seed", "root_seed", "overrides", "config_hash")
 _TAIL: tuple[str, ...] = ("extra_metrics", "visits", "attacks", "error", "wall_time",
-                          "finished_at")
+                          "finished_at", "factors")
 
 
 def _upsert(columns: tuple[str, ...]) -> str:
@@ -154,7 +156,8 @@ class ResultStore:
         present = {r[1] for r in self.db.execute("PRAGMA table_info(trials)")}
         #: metric columns the file has (a read-only older store may lack new ones)
         self.metric_names = tuple(m.name for m in self.metrics if m.name in present)
-        self.columns = (*_HEAD, *self.metric_names, *_TAIL)
+        self.columns = (*_HEAD, *self.metric_names,
+                        *(c for c in _TAIL if c in present))
 
     def _add_missing_columns(self) -> None:
         """A store written before a metric was registered gets its column (NULL so far)."""
@@ -162,6 +165,8 @@ class ResultStore:
         for m in self.metrics:
             if m.name not in present:
                 self.db.execute(f"ALTER TABLE trials ADD COLUMN {m.name} {m.sql_type}")
+        if "factors" not in present:  # a store written before designs had factors
+            self.db.execute("ALTER TABLE trials ADD COLUMN factors TEXT")
 
     # ------------------------------------------------------------------ context manager
     def __enter__(self) -> ResultStore:
@@ -240,6 +245,7 @@ class ResultStore:
             "error": row.get("error"),
             "wall_time": row.get("wall_time"),
             "finished_at": _now(),
+            "factors": json.dumps(dict(row.get("factors") or {}), sort_keys=True),
         }
         with self.db:
             self.db.execute(_upsert(self.columns), [values[c] for c in self.columns])
@@ -251,7 +257,7 @@ class ResultStore:
         """
         where = "error IS NOT NULL" if failed else "error IS NULL"
         columns = [c for c in self.columns if heatmaps or c not in ("visits", "attacks")]
-        order = ", ".join(IDENTITY)
+        order = ", ".join((*IDENTITY, "key"))  # key: factor levels of one identity in order
         query = f"SELECT {', '.join(columns)} FROM trials WHERE {where} ORDER BY {order}"
         for r in self.db.execute(query):
             trial = StoredTrial(zip(columns, tuple(r)))
@@ -262,6 +268,7 @@ class ResultStore:
                     trial[m.name] = None  # an older read-only store without the column
             trial["overrides"] = json.loads(trial["overrides"])
             trial["extra_metrics"] = json.loads(trial["extra_metrics"] or "{}")
+            trial["factors"] = json.loads(trial.get("factors") or "{}")
             if heatmaps:
                 trial["visits"] = unpack(trial["visits"])
                 trial["attacks"] = unpack(trial["attacks"])

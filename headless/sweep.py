@@ -27,6 +27,7 @@ from datetime import datetime, timezone
 from pathlib import Path
 from typing import IO, Any
 
+from game.config_file import read_config_file
 from game.trial import TrialSpec
 
 from .dirlock import DirectoryLock
@@ -41,6 +42,7 @@ from .executors import (
     terminate,
 )
 from .filenames import output_path
+from .growth import design_change, design_trials, grown_design
 from .presets import Preset, load_preset
 from .progress import Progress
 from .store import STORE_NAME, ResultStore
@@ -120,10 +122,12 @@ def _check_store(store_path: Path, preset: Preset, digests: dict[str, str]) -> N
     except Exception as error:
         raise SweepError(f"{store_path}: not a readable results store ({error})") from None
     old = meta.get("design")
-    if old is not None and json.loads(old) != preset.design():
+    change = design_change(json.loads(old), preset.design()) if old is not None else None
+    if change is not None:
         raise SweepError(
             f"{store_path}: holds results of a different design (preset "
-            f"{meta.get('preset_name', '?')!r}); use another --out or delete that directory")
+            f"{meta.get('preset_name', '?')!r}; {change} differ, and only seeds and factor "
+            "levels may grow); use another --out or delete that directory")
     old_hash = meta.get("config_hash")
     if old_hash is not None and old_hash != preset.config_hash:
         raise SweepError(
@@ -174,17 +178,21 @@ def run_sweep(
             raise SweepError(f"--out {out}: cannot create ({error.strerror or error})") from None
         lock = DirectoryLock(out)
         if progress:
+            factors = "".join(f" x {len(levels)} {key}" for key, levels in preset.factors)
             stream.write(f"stealth: preset {preset.name}: {preset.n_trials} trials "
                          f"({len(preset.levels)} levels x {len(preset.abstractions)} "
                          f"abstractions x {len(preset.guards)} guard modes x "
                          f"{len(preset.players)} player policies x {len(preset.scenarios)} "
-                         f"scenarios x {len(preset.seeds)} seeds) -> {out}\n")
+                         f"scenarios{factors} x {len(preset.seeds)} seeds) -> {out}\n")
         store = ResultStore(store_path)
         now = datetime.now(timezone.utc).isoformat(timespec="seconds")
+        old_design = store.get_meta("design")
+        design = (grown_design(json.loads(old_design), preset.design()) if old_design
+                  else preset.design())
         meta = {
             "preset_name": preset.name, "preset_source": preset.source,
-            "preset_toml": preset.text, "design": json.dumps(preset.design()),
-            "config_hash": preset.config_hash, "total_trials": str(preset.n_trials),
+            "preset_toml": preset.text, "design": json.dumps(design),
+            "config_hash": preset.config_hash, "total_trials": str(design_trials(design)),
             "config": json.dumps(dict(preset.config), sort_keys=True),
             "level_digests": json.dumps(digests, sort_keys=True),
             "updated_at": now,
@@ -323,6 +331,10 @@ def _drain(pending: dict[cf.Future[Any], list[TrialSpec]],
 # =========================================================================== command
 def _resume_command(args: argparse.Namespace, out: Path) -> str:
     words = ["stealth", "run", "--preset", args.preset, "--out", str(out)]
+    if args.seeds is not None:
+        words += ["--seeds", str(args.seeds)]
+    if args.config:
+        words += ["--config", args.config]
     if args.workers:
         words += ["--workers", str(args.workers)]
     if args.scheduler:
@@ -339,7 +351,10 @@ def cmd_run(args: argparse.Namespace) -> int:
     """
     if args.workers is not None:
         check_workers(args.workers)
-    preset = load_preset(args.preset)
+    extra = read_config_file(args.config) if args.config else None
+    preset = load_preset(args.preset, extra)
+    if args.seeds is not None:
+        preset = preset.with_seeds(args.seeds)
     out = Path(args.out) if args.out else output_path("results", preset.name)
     stderr = sys.stderr
     result = run_sweep(preset, out, workers=args.workers, scheduler=args.scheduler)

@@ -88,7 +88,8 @@ def table_rows(trials: Sequence[Mapping[str, Any]], abstractions: Sequence[str] 
         for column in columns:
             if trial["scenario"] != column.scenario:
                 continue
-            value = metric_value(trial, column, durations(trial["overrides"]))
+            settings = {**trial["overrides"], **trial.get("factors", {})}
+            value = metric_value(trial, column, durations(settings))
             if value is not None:
                 cell[column.name].append(value)
     present = {a for a, _, _ in groups}
@@ -122,15 +123,18 @@ def csv_value(value: Any) -> str:
 
 
 def write_trials_csv(trials: Sequence[Mapping[str, Any]], path: Path) -> None:
-    """``trials.csv``: identity, seed, config hash, every metric, ``wall_time`` last."""
+    """``trials.csv``: key, identity, one column per factor, config hash, every metric,
+    ``wall_time`` last."""
     names = metric_names()
     extras = sorted({k for t in trials for k in t.get("extra_metrics", {}) if k not in names})
-    columns = [*IDENTITY, "config_hash", *names, *extras, "wall_time"]
+    factors = sorted({k for t in trials for k in t.get("factors", {})})
+    columns = ["key", *IDENTITY, *factors, "config_hash", *names, *extras, "wall_time"]
     with path.open("w", newline="", encoding="utf-8") as handle:
         writer = csv.writer(handle)
         writer.writerow(columns)
         for t in trials:
-            merged = {**t.get("extra_metrics", {}), **{k: v for k, v in t.items() if v is not None}}
+            merged = {**t.get("extra_metrics", {}), **t.get("factors", {}),
+                      **{k: v for k, v in t.items() if v is not None}}
             writer.writerow([csv_value(merged.get(c)) for c in columns])
 
 

@@ -83,8 +83,8 @@ def test_trials_csv_has_one_row_per_trial_and_wall_time_last(swept: Path) -> Non
     rows = read(swept / "trials.csv")
     assert len(rows) == 32
     columns = list(rows[0])
-    assert columns[:8] == ["level", "abstraction", "guards", "player", "scenario", "seed",
-                           "root_seed", "config_hash"]
+    assert columns[:9] == ["key", "level", "abstraction", "guards", "player", "scenario",
+                           "seed", "root_seed", "config_hash"]  # SPEC §10: a key column
     assert columns[-1] == "wall_time"
     assert [c for c in columns if "time" in c and c != "wall_time"] == [
         "capture_time", "first_detect_time"]

@@ -312,7 +312,8 @@ def test_resume_refuses_a_different_design(tmp_path: Path,
     run_sweep(load_preset(str(write_preset(tmp_path, seeds=1, duration=3.0))), out, workers=1,
               progress=False)
     before = stored_rows(out)
-    other = write_preset(tmp_path, seeds=2, duration=3.0, name="other.toml")
+    # more seeds would grow the design (tests/test_experiments.py); another [set] is another
+    other = write_preset(tmp_path, seeds=2, duration=4.0, name="other.toml")
     assert main(["run", "--preset", str(other), "--out", str(out), "--workers", "1"]) == 2
     assert "different design" in capsys.readouterr().err
     assert stored_rows(out) == before

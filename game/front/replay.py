@@ -7,7 +7,8 @@ speed; a jump longer than any agent can walk in that time (a respawn) is shown a
 
 A trace written today names its level and the SHA-256 of its file in the first line, so
 ``--level`` is optional and a replay on another level (or an edited file) is refused; an
-older trace without a ``level`` key needs ``--level``. The node numbers refer to the grid or the partition graph; which one is detected from
+older trace without a ``level`` key needs ``--level``. ``stealth replay DIR --trial KEY``
+re-simulates a stored trial into a temporary trace first (:func:`replay_trial`). The node numbers refer to the grid or the partition graph; which one is detected from
 the positions (``--abstraction`` overrides).
 """
 
@@ -15,6 +16,7 @@ from __future__ import annotations
 
 import argparse
 import math
+import tempfile
 from collections.abc import Sequence
 from pathlib import Path
 
@@ -24,6 +26,7 @@ from game.agents import max_agent_speed
 from game.front.render import DrawOptions, FrameLoop, Renderer, default_window_size, init_pygame, pygame
 from game.scene import GuardDrawing, PlayerDrawing, Scene, SceneBuilder
 from game.trace import GuardRecord, Trace, TraceError, TraceLine, load_trace, parse_line
+from game.trial import TrialSpec
 from game.zones import ZoneMap
 from navmesh.graph import NodeGraph
 from navmesh.level import Level
@@ -362,7 +365,22 @@ def cmd_replay(args: argparse.Namespace) -> int:
     return 0
 
 
+def replay_trial(spec: TrialSpec, args: argparse.Namespace) -> int:
+    """``stealth replay DIR --trial KEY``: re-simulate the trial ``spec`` into a temporary
+    trace and play that back (the caller looks the spec up in the store)."""
+    from game.trial import run_trial
+
+    with tempfile.TemporaryDirectory(prefix="stealth-replay-") as folder:
+        path = Path(folder) / "trial.jsonl"
+        with path.open("w", encoding="utf-8") as handle:
+            run_trial(spec, trace=handle)
+        args.trace, args.level = str(path), spec.level
+        args.abstraction, args.scenario = spec.abstraction, spec.scenario
+        return cmd_replay(args)
+
+
 __all__: Sequence[str] = [
     "GuardRecord", "Playback", "ReplayViewer", "Trace", "TraceError", "TraceLine", "cmd_replay",
+    "replay_trial",
     "detect_abstraction", "load_trace", "parse_line",
 ]

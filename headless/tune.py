@@ -1,0 +1,344 @@
+"""``stealth tune SPEC.toml --out DIR``: a resumable Optuna study over the config (SPEC §10).
+
+SPEC.toml is a preset (the design; its ``seeds`` are replaced) plus
+
+* ``[search]`` — ``"key" = {low = , high = , log = false}`` (a float, or an int range when
+  both bounds are whole numbers) or ``{choices = [...]}``, each a config key;
+* ``[objective]`` — ``maximize = "EXPR"`` or ``minimize = "EXPR"`` (:mod:`headless.expr`),
+  optional ``constraints = ["EXPR <= N", ...]``; or ``target = "FILE.csv"`` (minimise the
+  distance to a table, :mod:`headless.objective`);
+* ``seeds_train = N``, ``seeds_test = M``, optional ``sampler_seed`` (default 0).
+
+Each Optuna trial runs the design on seeds 0…N−1 with its parameters as ``[set]`` values,
+through the executors of the sweeps (:mod:`headless.executors`: in-process, a process pool
+or Dask). The study lives in Optuna's SQLite storage ``DIR/study.db``: a killed study is
+resumed by the same command (the trial that was running is marked failed and asked again).
+The TPE sampler is re-seeded before each trial from ``sampler_seed`` and the number of
+trials finished so far, so a study gives the same parameters whether it ran at once or
+was interrupted and resumed. At the end the best feasible trial is re-evaluated on seeds
+N…N+M−1 and ``best.toml`` (a ``--config`` file), ``study.csv``, ``report.md`` and
+``history.png`` are written.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import os
+import sys
+import tomllib
+import warnings
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any, Literal
+
+from game.config_file import read_config_file, write_config_file
+from game.errors import ConfigError
+from game.trial import TrialSpec
+
+from .errors import SweepError, UserError
+from .executors import (InlineExecutor, connect_dask, process_pool, run_batch, shutdown,
+                        terminate)
+from .expr import Expression, parse_constraint, parse_expression
+from .objective import Target, as_trials, check_names, load_target, lookup_for
+from .presets import Preset, check_setting, parse_preset
+
+__all__ = ["Param", "TuneSpec", "cmd_tune", "load_tune_spec", "run_study"]
+
+STUDY_NAME = "stealth-tune"
+STUDIES_DIR = Path(__file__).resolve().parent / "studies"
+"""Bundled tune specs (``stealth tune paper-calibrate``)."""
+_TUNE_KEYS = ("search", "objective", "seeds_train", "seeds_test", "sampler_seed")
+
+
+@dataclass(frozen=True)
+class Param:
+    """One searched config key: a float/int range (``log`` scale or not) or choices."""
+
+    key: str
+    low: float | int | None = None
+    high: float | int | None = None
+    log: bool = False
+    choices: tuple[Any, ...] = ()
+
+    def suggest(self, trial: Any) -> Any:
+        """Optuna's suggestion for this key in ``trial``."""
+        if self.choices:
+            return trial.suggest_categorical(self.key, list(self.choices))
+        if isinstance(self.low, int) and isinstance(self.high, int):
+            return trial.suggest_int(self.key, self.low, self.high, log=self.log)
+        return trial.suggest_float(self.key, float(self.low or 0), float(self.high or 0),
+                                   log=self.log)
+
+
+@dataclass(frozen=True)
+class TuneSpec:
+    """A validated tune spec (see the module docstring)."""
+
+    path: Path
+    text: str
+    preset: Preset
+    params: tuple[Param, ...]
+    direction: Literal["maximize", "minimize"]
+    objective: Expression | None
+    constraints: tuple[Expression, ...]
+    target: Target | None
+    seeds_train: int
+    seeds_test: int
+    sampler_seed: int
+
+    def specs(self, values: Mapping[str, Any], seeds: Sequence[int]) -> list[TrialSpec]:
+        """The design's trials on ``seeds`` with ``values`` set (over the preset's [set])."""
+        overrides = tuple(sorted({**dict(self.preset.overrides), **values}.items()))
+        return [TrialSpec(level=s.level, abstraction=s.abstraction, guards=s.guards,
+                          player=s.player, scenario=s.scenario, seed=seed, overrides=overrides,
+                          root_seed=s.root_seed, factors=s.factors)
+                for seed in seeds for s in self.preset.specs() if s.seed == self.preset.seeds[0]]
+
+    def score(self, trials: Sequence[Mapping[str, Any]]) -> tuple[float, list[float], dict[str, Any]]:
+        """``(objective value, constraint values (<= 0 holds), extra facts)`` of some trials."""
+        lookup = lookup_for(trials)
+        constraints = [c.evaluate(lookup) for c in self.constraints]
+        if self.target is not None:
+            distance, within = self.target.distance(trials)
+            return distance, constraints, {"within_tolerance": within}
+        assert self.objective is not None
+        return self.objective.evaluate(lookup), constraints, {}
+
+
+def _count(data: Mapping[str, Any], key: str, src: str, minimum: int) -> int:
+    value = data.get(key)
+    if isinstance(value, bool) or not isinstance(value, int) or value < minimum:
+        raise UserError(f"{src}: {key}: expected a whole number >= {minimum}, got {value!r}")
+    return value
+
+
+def _param(key: str, table: Any, src: str, factors: set[str]) -> Param:
+    where = f"{src}: search.{key}"
+    if key in factors:
+        raise UserError(f"{where}: is also a factor of the design")
+    if not isinstance(table, Mapping):
+        raise UserError(f"{where}: expected {{low=, high=, log=}} or {{choices=[...]}}")
+    unknown = set(table) - {"low", "high", "log", "choices"}
+    if unknown:
+        raise UserError(f"{where}: unknown field {sorted(unknown)[0]!r}")
+    try:
+        if "choices" in table:
+            choices = table["choices"]
+            if set(table) != {"choices"} or not isinstance(choices, list) or not choices:
+                raise UserError(f"{where}: choices must be a non-empty list, alone")
+            return Param(key, choices=tuple(check_setting(key, c) for c in choices))
+        if "low" not in table or "high" not in table:
+            raise UserError(f"{where}: needs low and high (or choices)")
+        low, high = check_setting(key, table["low"]), check_setting(key, table["high"])
+    except ConfigError as error:
+        raise UserError(f"{where}: {error}") from None
+    log = table.get("log", False)
+    if not isinstance(log, bool):
+        raise UserError(f"{where}: log: expected true or false")
+    if isinstance(low, bool) or not isinstance(low, (int, float)) or not low < high:
+        raise UserError(f"{where}: expected numbers low < high, got {low!r}, {high!r}")
+    if log and low <= 0:
+        raise UserError(f"{where}: a log range needs low > 0")
+    return Param(key, low=low, high=high, log=log)
+
+
+def load_tune_spec(path: str | Path, extra: Mapping[str, Any] | None = None) -> TuneSpec:
+    """Read and validate a tune spec; ``extra`` (a ``--config`` file) goes over its ``[set]``."""
+    path = Path(path)
+    if not path.is_file() and (STUDIES_DIR / f"{path}.toml").is_file():
+        path = STUDIES_DIR / f"{path}.toml"  # a bundled study by name
+    src = str(path)
+    try:
+        text = path.read_text(encoding="utf-8")
+        data = tomllib.loads(text)
+    except FileNotFoundError:
+        raise UserError(f"{src}: no such tune spec") from None
+    except (OSError, UnicodeDecodeError, tomllib.TOMLDecodeError) as error:
+        raise UserError(f"{src}: cannot read ({' '.join(str(error).split())})") from None
+    seeds_train = _count(data, "seeds_train", src, 1)
+    seeds_test = _count(data, "seeds_test", src, 0)
+    sampler_seed = _count({"sampler_seed": data.get("sampler_seed", 0)}, "sampler_seed", src, 0)
+    design = {k: v for k, v in data.items() if k not in _TUNE_KEYS}
+    design["seeds"] = seeds_train
+    preset = parse_preset(design, src, name=path.stem, text=text, base=path.resolve().parent,
+                          extra=extra)
+    search = data.get("search")
+    if not isinstance(search, Mapping) or not search:
+        raise UserError(f"{src}: search: expected a table of config keys to search")
+    factors = {k for k, _ in preset.factors}
+    flat: dict[str, Any] = {}
+    for key, value in search.items():  # "a.b" = {...} and [search.a] b = {...} alike
+        if isinstance(value, Mapping) and not set(value) & {"low", "high", "log", "choices"}:
+            flat.update({f"{key}.{k}": v for k, v in value.items()})
+        else:
+            flat[key] = value
+    params = tuple(_param(k, v, src, factors) for k, v in sorted(flat.items()))
+
+    objective = data.get("objective")
+    if not isinstance(objective, Mapping):
+        raise UserError(f"{src}: objective: expected a table (maximize, minimize or target)")
+    ways = [k for k in ("maximize", "minimize", "target") if k in objective]
+    unknown = set(objective) - {"maximize", "minimize", "target", "constraints"}
+    if len(ways) != 1 or unknown:
+        raise UserError(f"{src}: objective: give exactly one of maximize, minimize, target "
+                        "(and optional constraints)")
+    selectors = {*preset.guards, *preset.players, *preset.abstractions, *preset.level_names}
+    expression = target = None
+    if ways[0] == "target":
+        target = load_target(str(objective["target"]), path.resolve().parent, {
+            "abstractions": preset.abstractions, "guards": preset.guards,
+            "players": preset.players, "scenarios": preset.scenarios})
+    else:
+        expression = parse_expression(objective[ways[0]])
+        check_names(expression, selectors, preset.scenarios, f"{src}: objective")
+    texts = objective.get("constraints", [])
+    if not isinstance(texts, list) or not all(isinstance(t, str) for t in texts):
+        raise UserError(f"{src}: objective.constraints: expected a list of comparisons")
+    constraints = tuple(parse_constraint(t) for t in texts)
+    for c in constraints:
+        check_names(c, selectors, preset.scenarios, f"{src}: objective.constraints")
+    return TuneSpec(path=path, text=text, preset=preset, params=params,
+                    direction="maximize" if ways[0] == "maximize" else "minimize",
+                    objective=expression, constraints=constraints, target=target,
+                    seeds_train=seeds_train, seeds_test=seeds_test, sampler_seed=sampler_seed)
+
+
+# --------------------------------------------------------------------------- evaluation
+def evaluate(executor: Any, specs: Sequence[TrialSpec], parallelism: int) -> list[dict[str, Any]]:
+    """Run ``specs`` over ``executor`` (batches of :func:`run_batch`) and return their rows
+    as trials; a failed trial raises :class:`SweepError`."""
+    size = max(1, min(8, math.ceil(len(specs) / (parallelism * 4))))
+    futures = [executor.submit(run_batch, list(specs[i:i + size]))
+               for i in range(0, len(specs), size)]
+    rows = [row for future in futures for row in future.result()]
+    for row in rows:
+        if row.get("error"):
+            raise SweepError(f"trial {row['key']} failed: {row['error'].splitlines()[0]}")
+    return as_trials(rows)
+
+
+def _feasible(trial: Any) -> bool:
+    return all(v <= 0 for v in trial.user_attrs.get("constraints", []))
+
+
+def _best(study: Any, direction: str) -> Any:
+    from optuna.trial import TrialState
+
+    done = [t for t in study.get_trials(deepcopy=False, states=[TrialState.COMPLETE])
+            if _feasible(t) and t.value is not None and math.isfinite(t.value)]
+    if not done:
+        return None
+    sign = -1.0 if direction == "maximize" else 1.0
+    return min(done, key=lambda t: (sign * t.value, t.number))
+
+
+def run_study(spec: TuneSpec, out: Path, trials: int, *, workers: int | None = None,
+              scheduler: str | None = None, stream: Any = None) -> Path:
+    """Run the study until it has ``trials`` finished trials, then write its outputs."""
+    try:
+        import optuna
+        from optuna.trial import TrialState
+    except ImportError:
+        raise UserError("stealth tune needs Optuna: pip install 'stealthfield[tune]'") from None
+    stream = stream if stream is not None else sys.stderr
+    optuna.logging.set_verbosity(optuna.logging.WARNING)
+    warnings.filterwarnings("ignore", category=optuna.exceptions.ExperimentalWarning)
+    if out.exists() and not out.is_dir():
+        raise UserError(f"--out {out}: exists and is not a directory")
+    out.mkdir(parents=True, exist_ok=True)
+    storage = f"sqlite:///{(out / 'study.db').resolve()}"
+    study = optuna.create_study(storage=storage, study_name=STUDY_NAME,
+                                direction=spec.direction, load_if_exists=True)
+    old = study.user_attrs.get("spec")
+    if old is None:
+        study.set_user_attr("spec", spec.text)
+        study.set_user_attr("config_hash", spec.preset.config_hash)
+    elif old != spec.text or study.user_attrs.get("config_hash") != spec.preset.config_hash:
+        raise UserError(f"--out {out}: holds a study of another spec or config; use another "
+                        "--out or delete that directory")
+    for stale in study.get_trials(deepcopy=False, states=[TrialState.RUNNING]):
+        study.tell(stale.number, state=TrialState.FAIL)  # killed mid-trial: asked again
+
+    client, executor, parallelism = None, None, 1
+    try:
+        if scheduler:
+            client, executor, parallelism = connect_dask(scheduler)
+        elif (workers or os.cpu_count() or 1) == 1:
+            executor = InlineExecutor()
+        else:
+            parallelism = workers or os.cpu_count() or 1
+            executor = process_pool(parallelism)
+        seeds = range(spec.seeds_train)
+        while True:
+            finished = study.get_trials(deepcopy=False, states=[TrialState.COMPLETE])
+            if len(finished) >= trials:
+                break
+            sampler = optuna.samplers.TPESampler(seed=spec.sampler_seed * 100_003 + len(finished))
+            current = optuna.load_study(study_name=STUDY_NAME, storage=storage, sampler=sampler)
+            trial = current.ask()
+            values = {p.key: p.suggest(trial) for p in spec.params}
+            try:
+                rows = evaluate(executor, spec.specs(values, seeds), parallelism)
+            except BaseException:
+                current.tell(trial, state=TrialState.FAIL)
+                raise
+            value, cons, facts = spec.score(rows)
+            trial.set_user_attr("constraints", cons)
+            for number, amount in enumerate(cons):  # <= 0 holds; TPE prefers feasible trials
+                trial.set_constraint(f"c{number}", amount)
+            for name, fact in facts.items():
+                trial.set_user_attr(name, fact)
+            if not math.isfinite(value):
+                current.tell(trial, state=TrialState.FAIL)
+                stream.write(f"stealth: tune trial {trial.number}: objective is not a number "
+                             "(a metric without trials?)\n")
+                continue
+            current.tell(trial, value)
+            stream.write(f"stealth: tune trial {trial.number} ({len(finished) + 1}/{trials}): "
+                         f"{value:.6g} {json.dumps(values)}\n")
+        best = _best(study, spec.direction)
+        test = None
+        if best is not None and spec.seeds_test:
+            cached = study.user_attrs.get("test")
+            if cached and cached.get("trial") == best.number:
+                test = cached
+            else:
+                held = range(spec.seeds_train, spec.seeds_train + spec.seeds_test)
+                rows = evaluate(executor, spec.specs(best.params, held), parallelism)
+                held_value, held_cons, held_facts = spec.score(rows)
+                test = {"trial": best.number, "value": held_value, "constraints": held_cons,
+                        **held_facts}
+                study.set_user_attr("test", test)
+    except KeyboardInterrupt:
+        if executor is not None:
+            terminate(executor)  # the pool's workers ignore Ctrl-C: end them now
+            executor = None
+        raise
+    finally:
+        if executor is not None:
+            shutdown(executor)
+        if client is not None:
+            client.close()
+    from .tune_report import write_study_outputs
+
+    write_study_outputs(spec, study, best, test, out)
+    return out
+
+
+def cmd_tune(args: argparse.Namespace) -> int:
+    """``stealth tune SPEC.toml --out DIR [--trials N] [--workers N] [--config FILE]``."""
+    if args.trials < 1:
+        raise UserError(f"--trials: must be at least 1, got {args.trials}")
+    if args.workers is not None and args.workers < 1:
+        raise UserError(f"--workers: must be at least 1, got {args.workers}")
+    extra = read_config_file(args.config) if args.config else None
+    spec = load_tune_spec(args.spec, extra)
+    out = Path(args.out)
+    run_study(spec, out, args.trials, workers=args.workers, scheduler=args.scheduler)
+    print(f"stealth: study in {out}: best.toml, study.csv, report.md", file=sys.stderr)
+    return 0
+
+
