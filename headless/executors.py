@@ -11,6 +11,7 @@ executor from a function here and pick it in :func:`headless.sweep.run_sweep`.
 from __future__ import annotations
 
 import concurrent.futures as cf
+import multiprocessing
 import os
 import signal
 import sys
@@ -99,6 +100,8 @@ def _die_with(parent: int) -> None:
             libc.prctl(_PR_SET_PDEATHSIG, int(signal.SIGKILL), 0, 0, 0)
         except (OSError, AttributeError):  # pragma: no cover - no usable libc: the watchdog
             pass
+    if multiprocessing.get_start_method() != "fork":
+        parent = os.getppid()  # forkserver/spawn: the server, which ends with the main process
     if os.getppid() != parent:  # the parent died before the death signal was armed
         os._exit(1)
     threading.Thread(target=_watch_parent, args=(parent,), name="parent-watchdog",
