@@ -162,6 +162,10 @@ class StaticScene:
     cell_node: np.ndarray | None
     #: partition: triangle corners ``(T, 3, 2)`` (node t is triangle t); None on a grid
     triangles: np.ndarray | None
+    #: exit areas' outer rings (objectives, game.objectives)
+    exits: tuple[np.ndarray, ...] = ()
+    #: collectible points ``(k, 2)``
+    collectibles: np.ndarray = field(default_factory=lambda: np.zeros((0, 2)))
 
     @classmethod
     def from_level(cls, level: Level, graph: NodeGraph) -> StaticScene:
@@ -186,6 +190,8 @@ class StaticScene:
             occupancy=np.asarray(level.occupancy, dtype=bool),
             cell_node=None if graph.cell_node is None else np.asarray(graph.cell_node),
             triangles=triangles,
+            exits=tuple(np.asarray(a.exterior.coords, dtype=np.float64)[:-1, :2] for a in level.exits),
+            collectibles=np.asarray(level.collectibles, dtype=np.float64).reshape(-1, 2),
         )
 
 
