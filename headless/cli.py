@@ -208,7 +208,14 @@ def _cmd_mechanics(args: argparse.Namespace) -> int:
 def _cmd_play(args: argparse.Namespace) -> int:
     from game.front.play import cmd_play
 
-    return cmd_play(args)
+    if args.record is None:
+        return cmd_play(args)
+    from .sessions import SessionStore
+
+    sink = SessionStore(args.record, args.set)
+    code = cmd_play(args, on_session=sink)
+    print(f"stealth: recorded {len(sink.stored)} session(s) into {args.record}", file=sys.stderr)
+    return code
 
 
 def _cmd_replay(args: argparse.Namespace) -> int:
@@ -349,7 +356,8 @@ def build_parser() -> argparse.ArgumentParser:
 
     p = command("play", "play a level interactively",
                 epilog="keys:\n" + key_table())
-    p.add_argument("level", help="level file or bundled name")
+    p.add_argument("level", nargs="?", default=None,
+                   help="level file or bundled name (default: choose one in the window)")
     p.add_argument("--guards", choices=modes, default="pf", help="guard mode")
     p.add_argument("--abstraction", choices=abstractions, default="grid",
                    help="node graph the AI runs on")
@@ -367,6 +375,10 @@ def build_parser() -> argparse.ArgumentParser:
                    help="capture: game over at HP 0; fixed: respawn, play the full duration")
     p.add_argument("--mesh", action="store_true", help="start with the grid / navmesh shown")
     p.add_argument("--plans", action="store_true", help="start with the guards' plans shown")
+    p.add_argument("--record", default=None, metavar="DIR",
+                   help="store every game as a trial (player human) in the results store DIR")
+    p.add_argument("--questions", action="store_true",
+                   help="with --record: ask three 1-5 ratings after each game")
     p.set_defaults(func=_cmd_play)
 
     p = command("replay", "replay a trace written by stealth sim --trace")
