@@ -7,7 +7,7 @@ drawn over a field (cones, zone and exit outlines, labels) uses colours outside 
 (white, green, violet, cyan) on a dark halo, so it stays readable over every overlay.
 
 >>> colors_of(np.array([-1.0, 0.0, 1.0])).tolist()
-[[255, 240, 120], [64, 64, 74], [175, 235, 255]]
+[[255, 240, 120], [63, 64, 75], [175, 235, 255]]
 """
 
 from __future__ import annotations

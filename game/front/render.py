@@ -30,7 +30,7 @@ from .camera import MIN_FIT_SCALE, START_SCALE, Camera
 from .layers import StaticLayers
 from .minimap import Minimap
 from .palette import (
-    ATTACK_RING, BACKGROUND, BAD, COLLECTIBLE, CONE, CONE_EDGE, CONE_SEEING, CONE_SEEING_EDGE,
+    ATTACK_RING, BACKGROUND, BAD, EXIT_EDGE, COLLECTIBLE, CONE, CONE_EDGE, CONE_SEEING, CONE_SEEING_EDGE,
     GOOD, GUARD, GUARD_ALERT, GUARD_DOWN, HALO, MARKER, PLAN_COLORS, PLAYER, PLAYER_SPRINT,
     TEXT, TEXT_DIM, WARN, Color, colormap_lut, colors_of,
 )
@@ -180,9 +180,10 @@ class Renderer:
         s, (ox, oy) = self.layout.scale, self.layout.origin
         return ((px - ox) / s, (py - oy) / s)
 
-    def _pts(self, points: np.ndarray) -> list[tuple[float, float]]:
+    def _pts(self, points: np.ndarray) -> list[list[float]]:
         s, (ox, oy) = self.layout.scale, self.layout.origin
-        return [(ox + x * s, oy + y * s) for x, y in np.asarray(points, dtype=float).reshape(-1, 2)]
+        pts = np.asarray(points, dtype=float).reshape(-1, 2) * s + (ox, oy)
+        return pts.tolist()
 
     # ------------------------------------------------------------------ the frame
     def draw(self, surface: pygame.Surface, scene: Scene, options: DrawOptions | None = None) -> None:
@@ -205,6 +206,10 @@ class Renderer:
             self._collectible(surface, self.to_screen(x, y), max(6.0, s * 0.35))
         for guard in scene.guards:
             self._draw_cone(surface, guard)
+        for ring in self.static.exits:
+            x, y = self.to_screen(float(ring[:, 0].min()), float(ring[:, 1].min()))
+            label = self._text("EXIT", self.small, EXIT_EDGE)
+            surface.blit(label, (round(x) + 4, round(y) + 3))
         if options.effects is not None:
             options.effects(surface, self)
         if options.show_plans:
@@ -223,10 +228,11 @@ class Renderer:
         surface.set_clip(None)
         self._draw_hud(surface, scene, options)
         self._draw_help(surface)
+        player = self.to_screen(*scene.player.pos)
         if options.panel is not None:
-            draw_panel(surface, area, options.panel)
+            draw_panel(surface, area, options.panel, avoid=player)
         elif options.banner:
-            draw_panel(surface, area, Panel(options.banner, (options.banner_sub,)))
+            draw_panel(surface, area, Panel(options.banner, (options.banner_sub,)), avoid=player)
         elif options.paused:
             draw_panel(surface, area, Panel("PAUSED", ("Space to continue",), where="corner"))
 
@@ -241,11 +247,11 @@ class Renderer:
             return  # off screen
         size = (max(1, hi[0] - lo[0]), max(1, hi[1] - lo[1]))
         layer = pygame.Surface(size, pygame.SRCALPHA)
-        local = [(float(x), float(y)) for x, y in pts - lo]
+        local = (pts - lo).tolist()
         pygame.draw.polygon(layer, CONE_SEEING if guard.sees_player else CONE, local)
         surface.blit(layer, (int(lo[0]), int(lo[1])))
         edge = CONE_SEEING_EDGE if guard.sees_player else CONE_EDGE
-        outline = [tuple(p) for p in pts.tolist()]
+        outline = pts.tolist()
         pygame.draw.lines(surface, HALO, True, outline, 4)
         pygame.draw.lines(surface, edge, True, outline, 2)
 
@@ -255,7 +261,7 @@ class Renderer:
         s = self.layout.scale
         width = max(2, round(s * 0.1))
         if len(guard.path):
-            pts = [self.to_screen(*guard.pos)] + self._pts(guard.path)
+            pts = [list(self.to_screen(*guard.pos))] + self._pts(guard.path)
             pygame.draw.lines(surface, HALO, False, pts, width + 2)
             pygame.draw.lines(surface, color, False, pts, width)
         r = max(6.0, s * 0.28)

@@ -42,8 +42,12 @@ def _font(size: int) -> pygame.font.Font:
     return font
 
 
-def draw_panel(surface: pygame.Surface, area: pygame.Rect, panel: Panel) -> pygame.Rect:
-    """Draw ``panel`` inside the map ``area``; returns the box drawn."""
+def draw_panel(surface: pygame.Surface, area: pygame.Rect, panel: Panel,
+               avoid: tuple[float, float] | None = None) -> pygame.Rect:
+    """Draw ``panel`` inside the map ``area``; returns the box drawn.
+
+    A wide panel goes along the top edge, or along the bottom edge when the ``avoid``
+    point (the player on screen) is in the upper half, so it never hides the player."""
     big = _font(46 if panel.where == "top" else 32)
     small = _font(22)
     title = big.render(panel.title, True, panel.title_color)
@@ -60,6 +64,8 @@ def draw_panel(surface: pygame.Surface, area: pygame.Rect, panel: Panel) -> pyga
         x, y = area.right - width - 10, area.top + 10
     else:
         x, y = area.centerx - width // 2, area.top + 10
+        if avoid is not None and avoid[1] < area.centery:
+            y = area.bottom - height - 10
     box = pygame.Rect(x, y, width, height)
     shade = pygame.Surface(box.size, pygame.SRCALPHA)
     shade.fill((0, 0, 0, 200))
