@@ -162,6 +162,10 @@ class StaticScene:
     cell_node: np.ndarray | None
     #: partition: triangle corners ``(T, 3, 2)`` (node t is triangle t); None on a grid
     triangles: np.ndarray | None
+    #: exit areas' outer rings (objectives, game.objectives)
+    exits: tuple[np.ndarray, ...] = ()
+    #: collectible points ``(k, 2)``
+    collectibles: np.ndarray = field(default_factory=lambda: np.zeros((0, 2)))
 
     @classmethod
     def from_level(cls, level: Level, graph: NodeGraph) -> StaticScene:
@@ -186,6 +190,8 @@ class StaticScene:
             occupancy=np.asarray(level.occupancy, dtype=bool),
             cell_node=None if graph.cell_node is None else np.asarray(graph.cell_node),
             triangles=triangles,
+            exits=tuple(np.asarray(a.exterior.coords, dtype=np.float64)[:-1, :2] for a in level.exits),
+            collectibles=np.asarray(level.collectibles, dtype=np.float64).reshape(-1, 2),
         )
 
 
@@ -330,6 +336,7 @@ class SceneBuilder:
         self._d = walls[:, 1] - walls[:, 0]
         corners = np.unique(walls.reshape(-1, 2), axis=0)
         self._corners = corners
+        self._buckets = _WallBuckets(walls, corners) if len(walls) > _BUCKET_MIN_WALLS else None
         self._layers: dict[str, tuple[tuple[int, ...], tuple[Any, ...], FieldLayer]] = {}
 
     # ------------------------------------------------------------------ cones
@@ -339,6 +346,10 @@ class SceneBuilder:
         The first point is the apex; the rest run counter-clockwise in angle (y down: from
         ``heading - fov/2`` to ``heading + fov/2``).
         """
+        if self._buckets is not None:  # a large level: only the walls near the guard
+            walls, corners = self._buckets.near(pos, reach)
+            return vision_cone(self._a[walls], self._d[walls], self._corners[corners], pos,
+                               heading, self.half_fov, reach, self.rays)
         return vision_cone(self._a, self._d, self._corners, pos, heading, self.half_fov,
                            reach, self.rays)
 
@@ -433,6 +444,41 @@ def _concealed(zones: Mapping[str, np.ndarray], node: int) -> bool:
 
 
 # ---------------------------------------------------------------------------- ray casting
+
+#: Levels with more wall segments than this bucket them for the cones (large levels).
+_BUCKET_MIN_WALLS = 2000
+_BUCKET_SIZE = 8.0
+
+
+class _WallBuckets:
+    """Wall segments and corners by square bucket, so a cone on a large level only tests
+    the walls near its guard (every wall within reach is still tested: same polygon)."""
+
+    def __init__(self, walls: np.ndarray, corners: np.ndarray) -> None:
+        lo = np.floor(walls.min(axis=1) / _BUCKET_SIZE).astype(np.int64)
+        hi = np.floor(walls.max(axis=1) / _BUCKET_SIZE).astype(np.int64)
+        self.walls: dict[tuple[int, int], list[int]] = {}
+        for i, ((x0, y0), (x1, y1)) in enumerate(zip(lo.tolist(), hi.tolist())):
+            for bx in range(x0, x1 + 1):
+                for by in range(y0, y1 + 1):
+                    self.walls.setdefault((bx, by), []).append(i)
+        self.corners: dict[tuple[int, int], list[int]] = {}
+        cells = np.floor(corners / _BUCKET_SIZE).astype(np.int64)
+        for i, (bx, by) in enumerate(cells.tolist()):
+            self.corners.setdefault((bx, by), []).append(i)
+
+    def near(self, pos: Sequence[float], reach: float) -> tuple[np.ndarray, np.ndarray]:
+        """Indices of the walls and corners in the buckets a disc of ``reach`` touches."""
+        x0, y0 = (math.floor((float(v) - reach) / _BUCKET_SIZE) for v in pos)
+        x1, y1 = (math.floor((float(v) + reach) / _BUCKET_SIZE) for v in pos)
+        walls: set[int] = set()
+        corners: list[int] = []
+        for bx in range(x0, x1 + 1):
+            for by in range(y0, y1 + 1):
+                walls.update(self.walls.get((bx, by), ()))
+                corners += self.corners.get((bx, by), [])
+        return (np.fromiter(sorted(walls), dtype=np.int64, count=len(walls)),
+                np.asarray(sorted(corners), dtype=np.int64))
 
 
 def vision_cone(

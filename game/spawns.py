@@ -26,6 +26,14 @@ def guard_spawn_nodes(graph: NodeGraph, level: Level, rng: np.random.Generator, 
     return [int(v) for v in rng.choice(graph.n, size=count, replace=False)]
 
 
+def level_start_node(graph: NodeGraph, level: Level, spawns: str) -> int | None:
+    """``spawns = "level"`` and a level that declares ``player``: the node of that point;
+    otherwise None (the player starts at :func:`start_node`)."""
+    if spawns != "level" or level.player is None:
+        return None
+    return graph.node_at(*level.player)
+
+
 def start_node(graph: NodeGraph, guards: Sequence[Agent], senses: Senses, view_range: float,
                rng: np.random.Generator) -> int:
     """The node farthest (min shortest path) from every active guard, out of their sight.
@@ -46,4 +54,4 @@ def start_node(graph: NodeGraph, guards: Sequence[Agent], senses: Senses, view_r
     return int(best[rng.integers(len(best))])
 
 
-__all__ = ["guard_spawn_nodes", "start_node"]
+__all__ = ["guard_spawn_nodes", "level_start_node", "start_node"]

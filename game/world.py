@@ -25,7 +25,7 @@ from .health import Health
 from .metrics import Counters, world_metrics
 from .schema import check_level
 from .senses import RANGE_EPS, Senses
-from .spawns import guard_spawn_nodes, start_node
+from .spawns import guard_spawn_nodes, level_start_node, start_node
 from .team import TeamRules
 from .zones import ZoneMap
 
@@ -103,7 +103,9 @@ class World(PlayerActions):
         self.guards = [self.locomotion.make_agent(node, guard_speed) for node in spawn_nodes]
         for guard in self.guards:
             guard.heading = float(spawn_rng.uniform(-math.pi, math.pi))
-        self.player = self.locomotion.make_agent(self.start_node(), player_speed)
+        first = level_start_node(self.graph, level, str(w["spawns"]))
+        self.player = self.locomotion.make_agent(
+            self.start_node() if first is None else first, player_speed)
         self.player_speed = player_speed
 
         self.guard_ai.reset(self.graph, guard_rng, len(self.guards))

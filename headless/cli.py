@@ -264,7 +264,14 @@ def _cmd_play(args: argparse.Namespace) -> int:
 
     if args.config:  # the file's overrides first, so --set still wins
         args.set = [f"{k}={v}" for k, v in read_config_file(args.config).items()] + args.set
-    return cmd_play(args)
+    if args.record is None:
+        return cmd_play(args)
+    from .sessions import SessionStore
+
+    sink = SessionStore(args.record, args.set)
+    code = cmd_play(args, on_session=sink)
+    print(f"stealth: recorded {len(sink.stored)} session(s) into {args.record}", file=sys.stderr)
+    return code
 
 
 def _cmd_replay(args: argparse.Namespace) -> int:
@@ -455,7 +462,8 @@ def build_parser() -> argparse.ArgumentParser:
 
     p = command("play", "play a level interactively",
                 epilog="keys:\n" + key_table())
-    p.add_argument("level", help="level file or bundled name")
+    p.add_argument("level", nargs="?", default=None,
+                   help="level file or bundled name (default: choose one in the window)")
     p.add_argument("--guards", choices=modes, default="pf", help="guard mode")
     p.add_argument("--abstraction", choices=abstractions, default="grid",
                    help="node graph the AI runs on")
@@ -475,6 +483,10 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--mesh", action="store_true", help="start with the grid / navmesh shown")
     p.add_argument("--plans", action="store_true", help="start with the guards' plans shown")
     add_stimulus(p, "add a stimulus to the game")
+    p.add_argument("--record", default=None, metavar="DIR",
+                   help="store every game as a trial (player human) in the results store DIR")
+    p.add_argument("--questions", action="store_true",
+                   help="with --record: ask three 1-5 ratings after each game")
     p.set_defaults(func=_cmd_play)
 
     p = command("replay", "replay a trace written by stealth sim --trace, or a stored trial")

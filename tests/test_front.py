@@ -47,8 +47,12 @@ def display():
     pygame.display.quit()
 
 
-def game(level: str = "miami", **settings) -> PlayGame:
-    return PlayGame(PlaySettings(level, **settings), lockstep=True, size=(960, 800))
+def game(level: str = "miami", start: bool = True, **settings) -> PlayGame:
+    """A lockstep game past its ready screen (``start=False``: still on it)."""
+    g = PlayGame(PlaySettings(level, **settings), lockstep=True, size=(960, 800))
+    if start:
+        g.start()
+    return g
 
 
 def pixels(surface: pygame.Surface) -> np.ndarray:
@@ -239,9 +243,12 @@ def test_keys_toggle_overlay_pause_and_mode() -> None:
         assert (g.overlay, g.show_mesh, g.show_plans, g.paused) == ("I", True, True, True)
         assert g.world.step_index == 0  # paused from the first frame on
         pygame.event.post(pygame.event.Event(pygame.KEYDOWN, key=pygame.K_3))
-        g.run(10)
+        g.run(1)
+        assert g.state == "ready" and g.world.step_index == 0  # a restart waits for a move
+        g.start()
+        g.run(9)
         assert g.mode == "fsm" and g.world.guard_ai.mode == "fsm" and not g.paused
-        assert g.world.step_index == 10
+        assert g.world.step_index == 9
     finally:
         g.close()
 
@@ -290,6 +297,7 @@ def test_keyboard_moves_and_sprints_the_player(monkeypatch: pytest.MonkeyPatch) 
 
 def test_real_time_mode_steps_by_elapsed_time_and_resizes() -> None:
     g = PlayGame(PlaySettings("maze"), lockstep=False, size=(960, 800))
+    g.start()
     try:
         g.frame(3.5 * g.world.dt)
         assert g.world.step_index == 3  # the remaining half step waits for the next frame
@@ -322,10 +330,11 @@ def test_capture_ends_the_game_and_enter_restarts() -> None:
                 break
         assert g.world.done and g.scene.status == "captured"
         opts = g.options()
-        assert opts.banner == "CAUGHT"
+        assert g.state == "over" and opts.panel is not None and opts.panel.title == "CAUGHT"
+        assert any("captures 1" in line for line in opts.panel.lines)  # the trial's metrics
         pygame.event.post(pygame.event.Event(pygame.KEYDOWN, key=pygame.K_RETURN))
         g.run(1)
-        assert not g.world.done and g.world.step_index == 1
+        assert not g.world.done and g.state == "ready" and g.world.step_index == 0
     finally:
         g.close()
 

@@ -24,11 +24,13 @@ KEY_HELP: tuple[tuple[str, str], ...] = (
     ("F", "take down the guard in reach (leaves a corpse)"),
     ("R", "toggle rain"),
     ("Space", "pause"),
+    ("wheel / + -", "zoom (the camera follows you)"),
     ("O / Tab", "next field overlay (none, I, C, N, P, K, ...)"),
     ("M", "show the grid / navmesh"),
     ("G", "show the guards' plans"),
     (f"1-{len(MODE_ORDER)}", "restart with guards " + "/".join(MODE_ORDER)),
     ("Enter", "restart"),
+    ("N / B", "next / previous level"),
     ("Esc", "quit"),
 )
 

@@ -15,6 +15,7 @@ and screenshots are reproducible.
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import gc
 import sys
 import time
@@ -22,10 +23,10 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from typing import Any
 
+from game.front.camera import ZOOM_STEP, Camera
+from game.front.effects import NoiseRings, draw_rain
+from game.front.palette import BAD, GOOD, WARN
 from game.front.render import (
-    BAD,
-    GOOD,
-    WARN,
     DrawOptions,
     FrameLoop,
     Renderer,
@@ -36,8 +37,16 @@ from game.front.render import (
 )
 from game.errors import FrontError
 from game.front.keys import KEY_HELP, MODE_ORDER
+from navmesh.level import bundled_level_names
+from game.front.screens import Panel
+from game.objectives import Objectives
+from game.record import HUMAN, QUESTIONS, Recording
 from game.scene import OVERLAYS, Scene, SceneBuilder, overlay_key
+from game.trial import TrialSpec
 from game.world import World
+
+#: What ``--record`` hands the command line for every finished session: the row and trace.
+SessionSink = Callable[[dict[str, Any], Sequence[str]], None]
 
 #: Guard modes on the number keys, in the order of SPEC §9.
 MODE_KEYS: dict[int, str] = {pygame.K_1 + i: mode for i, mode in enumerate(MODE_ORDER)}
@@ -78,13 +87,21 @@ class PlaySettings:
     show_plans: bool = False
     #: plugin stimuli, ``"FILE.py:NAME"`` or entry-point names (``--stimulus``)
     stimuli: tuple[str, ...] = ()
+    #: keep every game as a trial row (``stealth play --record DIR``)
+    record: bool = False
+    #: ask the post-game questionnaire (``--questions``, with ``--record``)
+    questions: bool = False
+    #: the levels N (next level) cycles through
+    playlist: tuple[str, ...] = ()
 
 
 class PlayGame(FrameLoop):
     """One game window: world, scene builder, renderer and the input handling.
 
     ``lockstep=True`` advances exactly one physics step per :meth:`frame`; otherwise the
-    world follows the wall clock.
+    world follows the wall clock. A game starts on the ready screen (``state == "ready"``):
+    the clock starts with the player's first move (at once with an autopilot). It ends
+    ``"over"`` (won, caught or time up), after the questionnaire (``"questions"``) when asked.
 
     Usage (opens a window)::
 
@@ -95,12 +112,14 @@ class PlayGame(FrameLoop):
     def __init__(
         self, settings: PlaySettings, *, lockstep: bool = True,
         size: tuple[int, int] | None = None, screen: pygame.Surface | None = None,
+        on_session: SessionSink | None = None,
     ) -> None:
         from game.config import Config
 
         init_pygame()
         self.settings = settings
         self.lockstep = lockstep
+        self.on_session = on_session
         self.config = Config.load({"world.spawns": "level"}).with_overrides(settings.overrides)
         self.autopilot = settings.autopilot
         self.overlay = overlay_key(settings.overlay)
@@ -108,26 +127,34 @@ class PlayGame(FrameLoop):
         self.paused = False
         self.running = True
         self.message, self.message_color, self._message_until = "", WARN, 0.0
-        self.world = self._build_world(settings.guards)
+        self.camera = Camera()
+        self.clock = pygame.time.Clock()
+        self.sessions: list[dict[str, Any]] = []
+        self._size, self._screen = size, screen
+        self._load(settings.level, settings.guards)
+        _freeze_heap()
+
+    def _load(self, level: str, mode: str) -> None:
+        """(Re)build world, scene builder and renderer for ``level`` (a new level or the first)."""
+        self.settings = dataclasses.replace(self.settings, level=level)
+        self.world = self._build_world(mode)
         self.level = self.world.level
         self.builder = SceneBuilder(
             self.level, self.world.graph, view_range=self.world.view_range,
             fov_deg=float(self.config["world.fov_deg"]),
         )
-        size = size or default_window_size(self.builder.static)
-        if screen is None:
+        if self._screen is None:
             pygame.display.set_caption(f"Stealthfield — {self.level.name}")
-            screen = pygame.display.set_mode(size, pygame.RESIZABLE)
-        self.screen = screen
-        self.renderer = Renderer(self.builder.static, self.screen.get_size())
-        self.clock = pygame.time.Clock()
-        self._accumulator = 0.0
+            size = self._size or default_window_size(self.builder.static)
+            self._screen = pygame.display.set_mode(size, pygame.RESIZABLE)
+        self.screen = self._screen
+        self.camera = Camera()
+        self.renderer = Renderer(self.builder.static, self.screen.get_size(), self.camera)
         self.scene: Scene | None = None
-        _freeze_heap()
 
     # ------------------------------------------------------------------ world
     def _build_world(self, mode: str) -> World:
-        from game.trial import TrialSpec, make_world
+        from game.trial import make_world
 
         self.mode = mode
         spec = TrialSpec(
@@ -138,20 +165,82 @@ class PlayGame(FrameLoop):
         world = make_world(spec, self.config, interactive=True)
         if self.autopilot is None:
             world.player_input = (0.0, 0.0)  # the keyboard drives; the policy never runs
+        self.goal = Objectives.of(world.level)
+        self.rings = NoiseRings()
+        self.state = "ready" if self.autopilot is None else "playing"
+        self.outcome = ""
+        self.answers: dict[str, int] = {}
+        self._accumulator = 0.0
+        self.recording: Recording | None = None
+        if self.settings.record:
+            identity = dataclasses.replace(spec, player=HUMAN, overrides=self.identity_overrides())
+            self.recording = Recording(identity, self.config)
+            self.recording.attach(world)
         return world
+
+    def identity_overrides(self) -> tuple[tuple[str, Any], ...]:
+        """The config changes a session is played with (its trial identity's overrides)."""
+        from game.config import parse_overrides
+
+        keys = dict.fromkeys(k for k, _ in parse_overrides(self.settings.overrides))
+        return (("world.spawns", "level"),) + tuple(
+            (k, self.config[k]) for k in keys if k != "world.spawns")
 
     def restart(self, mode: str | None = None) -> None:
         """A fresh world on the same level and seed (optionally with another guard mode)."""
+        self._close_session("restarted")
         self.world = self._build_world(mode or self.mode)
         _freeze_heap()
         self.paused = False
-        self._accumulator = 0.0
         self.flash(f"restarted: guards {self.mode}", GOOD)
+
+    def next_level(self, step: int = 1) -> None:
+        """Load the next (``step=-1``: previous) level of the playlist, same guards and seed."""
+        names = list(self.settings.playlist) or bundled_level_names()
+        current = self.settings.level
+        k = names.index(current) if current in names else -1
+        self._close_session("left")
+        self._load(names[(k + step) % len(names)], self.mode)
+        _freeze_heap()
+        self.flash(f"level {self.level.name}", GOOD)
 
     def flash(self, text: str, color: tuple[int, int, int] = WARN) -> None:
         """Show a short message in the HUD for a few seconds."""
         self.message, self.message_color = text, color
         self._message_until = time.monotonic() + MESSAGE_SECONDS
+
+    # ------------------------------------------------------------------ sessions
+    def _result(self) -> dict[str, Any]:
+        return {"won": self.outcome == "won", "outcome": self.outcome or "quit",
+                "collected": int(self.goal.collected.sum()),
+                "collectibles": int(len(self.goal.collected))}
+
+    def _close_session(self, why: str) -> None:
+        """Store the session of the current world once (a game left before its first move is
+        not a session)."""
+        if self.recording is None or self.world.step_index == 0:
+            self.recording = None
+            return
+        if not self.outcome:
+            self.outcome = why
+        row = self.recording.finish(self.world, self._result(), self.answers)
+        self.sessions.append(row)
+        if self.on_session is not None:
+            self.on_session(row, self.recording.trace_lines())
+        self.recording = None
+
+    def _game_over(self) -> None:
+        if self.goal.won:
+            self.outcome = "won"
+        elif self.world.end_on_capture and self.world.m.captures:
+            self.outcome = "caught"
+        else:
+            self.outcome = "survived" if not self.goal.has_goal else "time up"
+        if self.recording is not None and self.settings.questions:
+            self.state = "questions"
+        else:
+            self.state = "over"
+            self._close_session(self.outcome)
 
     # ------------------------------------------------------------------ input
     def help_items(self) -> list[str]:
@@ -160,7 +249,7 @@ class PlayGame(FrameLoop):
 
     def _mechanic(self, method: str, *args: float) -> None:
         action, label = MECHANICS[method]
-        if self.world.done:
+        if self.world.done or self.state != "playing":
             return
         try:
             result = action(self.world, *args)
@@ -183,10 +272,21 @@ class PlayGame(FrameLoop):
             static = self.builder.static
             if 0 <= x <= static.width and 0 <= y <= static.height:
                 self._mechanic("throw_decoy", x, y)
+        elif event.type == pygame.MOUSEWHEEL and event.y:
+            self.zoom(ZOOM_STEP if event.y > 0 else 1 / ZOOM_STEP)
         elif event.type == pygame.KEYDOWN:
             self._key(event.key)
 
+    def zoom(self, factor: float) -> None:
+        """Zoom the camera in (factor > 1) or out, around the player."""
+        self.camera.follow(self.world.player.pos)
+        self.camera.zoom_by(factor, self.renderer.fit_scale())
+        self.renderer.refresh_view()
+
     def _key(self, key: int) -> None:
+        if self.state == "questions":
+            self._answer(key)
+            return
         if key == pygame.K_ESCAPE:
             self.running = False
         elif key == pygame.K_SPACE:
@@ -198,8 +298,16 @@ class PlayGame(FrameLoop):
             self.show_mesh = not self.show_mesh
         elif key == pygame.K_g:
             self.show_plans = not self.show_plans
+        elif key in (pygame.K_EQUALS, pygame.K_PLUS, pygame.K_KP_PLUS):
+            self.zoom(ZOOM_STEP)
+        elif key in (pygame.K_MINUS, pygame.K_KP_MINUS):
+            self.zoom(1 / ZOOM_STEP)
         elif key in (pygame.K_RETURN, pygame.K_KP_ENTER):
             self.restart()
+        elif key == pygame.K_n:
+            self.next_level()
+        elif key == pygame.K_b:
+            self.next_level(-1)
         elif key in MODE_KEYS:
             self.restart(MODE_KEYS[key])
         elif key == pygame.K_e:
@@ -209,14 +317,29 @@ class PlayGame(FrameLoop):
         elif key == pygame.K_r:
             self._mechanic("toggle_rain")
 
+    def _answer(self, key: int) -> None:
+        """Questionnaire keys: 1-5 rate the current question, Esc / Enter skip the rest."""
+        if pygame.K_1 <= key <= pygame.K_5:
+            name = QUESTIONS[len(self.answers)][0]
+            self.answers[name] = key - pygame.K_0
+            if len(self.answers) < len(QUESTIONS):
+                return
+        elif key not in (pygame.K_ESCAPE, pygame.K_RETURN, pygame.K_KP_ENTER):
+            return
+        self.state = "over"
+        self._close_session(self.outcome)
+        self.flash("session recorded", GOOD)
+
     def _steer(self) -> None:
-        """Keyboard → ``world.player_input`` and ``world.sprinting``."""
+        """Keyboard → ``world.player_input`` and ``world.sprinting``; the first move starts."""
         pressed = pygame.key.get_pressed()
         vx = vy = 0.0
         for key, dx, dy in _MOVE_KEYS:
             if pressed[key]:
                 vx, vy = vx + dx, vy + dy
         vx, vy = max(-1.0, min(1.0, vx)), max(-1.0, min(1.0, vy))
+        if (vx or vy) and self.state == "ready":
+            self.state = "playing"
         if self.autopilot is not None:
             if not (vx or vy):
                 return
@@ -228,43 +351,105 @@ class PlayGame(FrameLoop):
         self.world.sprinting = bool(mods & pygame.KMOD_SHIFT)
 
     # ------------------------------------------------------------------ frames
+    def idle(self) -> bool:
+        """Paused, on the ready screen or after the game: nothing moves without a key."""
+        return self.paused or self.state != "playing"
+
+    def start(self) -> None:
+        """Leave the ready screen now (what the first move does)."""
+        if self.state == "ready":
+            self.state = "playing"
+
+    def _step(self) -> None:
+        self.world.step()
+        events = self.goal.update(self.world.player.pos)
+        if "collected" in events:
+            self.flash(f"picked up ({self.goal.remaining} left)", GOOD)
+        if "escaped" in events:
+            self.world.stop()
+
     def update(self, elapsed: float) -> None:
         """Advance the world: one step in lockstep, else ``elapsed`` seconds of game time."""
-        if self.paused or self.world.done:
+        if self.paused or self.state in ("over", "questions"):
             self._accumulator = 0.0
             return
         self._steer()
-        if self.lockstep:
-            self.world.step()
+        if self.state == "ready":
             return
-        self._accumulator = min(self._accumulator + elapsed, MAX_STEPS_PER_FRAME * self.world.dt)
-        while self._accumulator >= self.world.dt and not self.world.done:
-            self.world.step()
-            self._accumulator -= self.world.dt
+        if self.lockstep:
+            self._step()
+        else:
+            self._accumulator = min(self._accumulator + elapsed, MAX_STEPS_PER_FRAME * self.world.dt)
+            while self._accumulator >= self.world.dt and not self.world.done:
+                self._step()
+                self._accumulator -= self.world.dt
+        self.rings.observe(self.world)
+        if self.world.done:
+            self._game_over()
+
+    def panel(self) -> Panel | None:
+        """The screen over the map now (ready, questionnaire, game over), if any."""
+        goal = self.goal
+        if self.state == "ready":
+            if goal.has_goal:
+                task = (f"Pick up the {len(goal.collected)} stars, then reach" if len(goal.collected)
+                        else "Reach") + " the green exit without being caught"
+            else:
+                task = f"Survive {self.world.total_steps * self.world.dt:g} s without being caught"
+            return Panel(f"{self.level.name}: ready", (task, "The clock starts on your first move (WASD / arrows)"),
+                         GOOD, hint="N next level · B previous · Esc quit")
+        if self.state == "questions":
+            k = len(self.answers)
+            return Panel("Your view (1-5)", [q for _, q in QUESTIONS], WARN, choice=k,
+                         hint="press 1-5 for the marked question · Enter skip")
+        if self.state == "over":
+            return self._over_panel()
+        return None
+
+    def _over_panel(self) -> Panel:
+        m = self.world.metrics()
+        titles = {"won": ("ESCAPED", GOOD), "caught": ("CAUGHT", BAD),
+                  "survived": ("SURVIVED", GOOD), "time up": ("TIME UP", WARN)}
+        title, color = titles.get(self.outcome, (self.outcome.upper(), WARN))
+        seen = m["first_detect_time"]
+        lines = [f"time {self.world.t:.1f} s · captures {m['captures']} · first seen "
+                 + ("never" if seen is None else f"at {seen:.1f} s")]
+        lines.append(f"mean guard distance {m['avg_guard_player_dist']:.1f} · guard coverage "
+                     f"{100 * m['coverage']:.0f} %"
+                     + (f" · stars {int(self.goal.collected.sum())}/{len(self.goal.collected)}"
+                        if len(self.goal.collected) else ""))
+        return Panel(title, lines, color,
+                     hint="Enter restart · N next level · 1-5 other guards · Esc quit")
 
     def options(self) -> DrawOptions:
         """Display options and HUD texts for this frame."""
-        banner, sub = None, ""
-        world = self.world
-        if world.done:
-            if world.end_on_capture and world.m.captures:
-                banner = "CAUGHT"
-                sub = f"after {world.m.capture_time:.1f} s · Enter restart · 1-5 other guards · Esc quit"
-            else:
-                banner = "SURVIVED" if not world.m.captures else "TIME UP"
-                caught = f"caught {world.m.captures}× · " if world.m.captures else ""
-                sub = f"{caught}{world.t:.0f} s · Enter restart · 1-5 other guards · Esc quit"
         message = self.message if time.monotonic() < self._message_until else ""
         info = [f"autopilot {self.autopilot}"] if self.autopilot else []
+        if self.goal.has_goal:
+            info.append(f"stars {int(self.goal.collected.sum())}/{len(self.goal.collected)}"
+                        if len(self.goal.collected) else "goal: exit")
+        if self.recording is not None:
+            info.append("REC")
         return DrawOptions(
-            show_mesh=self.show_mesh, show_plans=self.show_plans, paused=self.paused,
+            show_mesh=self.show_mesh, show_plans=self.show_plans,
+            paused=self.paused and self.state == "playing",
             help=self.help_items(), message=message, message_color=self.message_color,
-            banner=banner, banner_sub=sub, info=info,
+            info=info, panel=self.panel(),
+            collectibles=self.goal.collectibles[~self.goal.collected],
+            effects=self._effects,
         )
+
+    def _effects(self, surface: pygame.Surface, renderer: Renderer) -> None:
+        if self.world.raining:
+            draw_rain(surface, renderer.layout.world_rect, self.world.t)
+        self.rings.draw(surface, renderer.to_screen, renderer.layout.scale, self.world.t)
 
     def draw(self) -> Scene:
         """Build the scene of the world now and draw it to the window."""
         scene = self.builder.from_world(self.world, self.overlay, plans=self.show_plans)
+        if self.camera.zoom is not None:
+            self.camera.follow(self.world.player.pos)
+            self.renderer.refresh_view()
         self.renderer.draw(self.screen, scene, self.options())
         self.scene = scene
         return scene
@@ -280,7 +465,8 @@ class PlayGame(FrameLoop):
         pygame.display.flip()
 
     def close(self) -> None:
-        """Give the frozen heap back to the garbage collector (the window stays to the caller)."""
+        """Store the session still open (if recording) and give the frozen heap back."""
+        self._close_session("quit")
         gc.unfreeze()
 
 
@@ -329,14 +515,19 @@ def finish(surface: pygame.Surface, screenshot: str | None, times: Sequence[floa
         print(f"{len(times)} frames, median {median:.2f} ms, p99 {p99:.2f} ms{shot}", file=sys.stderr)
 
 
-def cmd_play(args: argparse.Namespace) -> int:
-    """``stealth play LEVEL``: see the module docstring and docs/play.md."""
+def cmd_play(args: argparse.Namespace, on_session: SessionSink | None = None) -> int:
+    """``stealth play [LEVEL]``: see the module docstring and docs/play.md.
+
+    Without a level a chooser lists the bundled levels. ``on_session`` receives every
+    finished session's row and trace (the command line stores them for ``--record``).
+    """
     from ai.stimuli import load_stimulus
     from navmesh.level import load_level
 
     for plugin in args.stimulus:  # before the level: a plugin may declare its zone kinds
         load_stimulus(plugin)  # a bad plugin fails here with its one-line message
-    load_level(args.level)  # a bad level fails here with its one-line message
+    if args.level is not None:
+        load_level(args.level)  # a bad level fails here with its one-line message
     try:
         overlay = overlay_key(args.overlay)
     except ValueError as error:
@@ -346,14 +537,25 @@ def cmd_play(args: argparse.Namespace) -> int:
     from game.config import Config
 
     Config.load({"world.spawns": "level"}).with_overrides(args.set)  # bad --set: one line
+    open_display()
+    level = args.level
+    if level is None:
+        from game.front.chooser import LevelChooser
+
+        pygame.display.set_caption("Stealthfield")
+        chooser = LevelChooser(pygame.display.set_mode((960, 640)), bundled_level_names())
+        level = chooser.run()
+        if level is None:
+            pygame.display.quit()
+            return 0
     settings = PlaySettings(
-        level=args.level, guards=args.guards, abstraction=args.abstraction,
+        level=level, guards=args.guards, abstraction=args.abstraction,
         scenario=args.scenario, seed=args.seed,
         overrides=tuple(args.set), autopilot=args.autopilot, overlay=overlay,
         show_mesh=args.mesh, show_plans=args.plans, stimuli=tuple(args.stimulus),
+        record=on_session is not None, questions=bool(getattr(args, "questions", False)),
     )
-    open_display()
-    game = PlayGame(settings, lockstep=lockstep_wanted(args.frames))
+    game = PlayGame(settings, lockstep=lockstep_wanted(args.frames), on_session=on_session)
     try:
         times = game.run(args.frames)
         finish(game.screen, args.screenshot, times)

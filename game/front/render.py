@@ -1,13 +1,14 @@
 """The pygame adapter: draws a :class:`~game.scene.Scene` into a window (or any Surface).
 
-The static background (floor, zones, walls, optional grid or navmesh lines and the
-colour-mapped field overlay) is composed once into a cached Surface and rebuilt only when
-the window is resized, the overlay's field changes (once per AI tick) or a display option
-is toggled; every frame then blits it and draws only what moves: cones, agents, plans, HUD.
+The static background (floor, zones, field overlay, lines, walls) comes from the cached
+:class:`~game.front.layers.StaticLayers`; every frame blits it and draws only what moves:
+cones, agents, plans, noise rings, HUD. A :class:`~game.front.camera.Camera` says what part
+of the level the window shows: the whole level (small levels) or a zoomed view that
+follows the player, with a :class:`~game.front.minimap.Minimap` in the corner.
 
-Field colours come from one diverging colour map on ``FieldLayer.norm`` in [-1, 1]:
-warm (yellow, red) for negative values, which attract the guards (they move to the
-least K), cold (blue) for positive values, which repel them, neutral grey for 0.
+Drawing order keeps everything readable over every overlay: cones (light fill, white
+outline on a dark halo, colours outside the colour map), plans, bodies, plan targets, the
+player, then every text label last on a dark box, so no marker hides one.
 """
 
 from __future__ import annotations
@@ -25,63 +26,15 @@ import pygame
 
 from game.scene import GuardDrawing, Scene, StaticScene
 
-Color = tuple[int, int, int]
-
-# ---------------------------------------------------------------------------- palette
-BACKGROUND: Color = (16, 17, 22)
-BLOCKED: Color = (30, 32, 40)
-FLOOR: Color = (86, 90, 100)
-ZONE_FILL: dict[str, Color] = {"dark": (44, 46, 70), "concealment": (58, 104, 62)}
-ZONE_EDGE: dict[str, Color] = {"dark": (120, 120, 200), "concealment": (120, 210, 120)}
-WALL: Color = (236, 236, 244)
-MESH: Color = (130, 134, 150)
-DECOY: Color = (200, 130, 255)
-MARKER: Color = (255, 160, 230)
-CONE = (255, 232, 130, 78)
-CONE_EDGE: Color = (255, 232, 130)
-CONE_SEEING = (255, 60, 50, 110)
-CONE_SEEING_EDGE: Color = (255, 90, 80)
-GUARD: Color = (240, 140, 40)
-GUARD_ALERT: Color = (235, 60, 50)
-GUARD_DOWN: Color = (110, 110, 120)
-PLAYER: Color = (80, 210, 255)
-PLAYER_SPRINT: Color = (160, 240, 255)
-ATTACK_RING: Color = (140, 70, 60)
-TEXT: Color = (230, 232, 240)
-TEXT_DIM: Color = (150, 154, 168)
-GOOD: Color = (110, 220, 120)
-BAD: Color = (255, 90, 80)
-WARN: Color = (255, 200, 80)
-PLAN_COLORS: tuple[Color, ...] = (
-    (255, 170, 60), (240, 90, 220), (80, 230, 200), (250, 250, 110), (150, 160, 255),
+from .camera import MIN_FIT_SCALE, START_SCALE, Camera
+from .layers import StaticLayers
+from .minimap import Minimap
+from .palette import (
+    ATTACK_RING, BACKGROUND, BAD, EXIT_EDGE, COLLECTIBLE, CONE, CONE_EDGE, CONE_SEEING, CONE_SEEING_EDGE,
+    GOOD, GUARD, GUARD_ALERT, GUARD_DOWN, HALO, MARKER, PLAN_COLORS, PLAYER, PLAYER_SPRINT,
+    TEXT, TEXT_DIM, WARN, Color, colormap_lut, colors_of,
 )
-OVERLAY_ALPHA = 215
-_KEY: Color = (255, 0, 255)  # colour key of the cached line layers (never drawn)
-
-# Diverging colour map stops on [-1, 1] (attractive warm, repulsive cold).
-_STOPS = np.array([-1.0, -0.5, 0.0, 0.5, 1.0])
-_STOP_COLORS = np.array(
-    [[255, 240, 120], [235, 80, 40], [64, 64, 74], [50, 110, 225], [175, 235, 255]], dtype=float
-)
-LUT_SIZE = 256
-
-
-def colormap_lut(size: int = LUT_SIZE) -> np.ndarray:
-    """The diverging colour map as ``(size, 3)`` uint8, index 0 = -1, last = +1."""
-    x = np.linspace(-1.0, 1.0, size)
-    return np.stack([np.interp(x, _STOPS, _STOP_COLORS[:, k]) for k in range(3)], axis=1).astype(
-        np.uint8
-    )
-
-
-_LUT = colormap_lut()
-
-
-def colors_of(norm: np.ndarray) -> np.ndarray:
-    """Colours ``(n, 3)`` uint8 of normalised values in [-1, 1]."""
-    idx = np.clip(np.rint((np.asarray(norm) + 1.0) * 0.5 * (LUT_SIZE - 1)), 0, LUT_SIZE - 1)
-    return _LUT[idx.astype(np.intp)]
-
+from .screens import Panel, draw_panel
 
 def init_pygame() -> None:
     """Initialise only what the front end uses (display, fonts): no audio device needed."""
@@ -101,13 +54,19 @@ class DrawOptions:
     #: short status text shown in the HUD (last action, speed, ...)
     message: str = ""
     message_color: Color = WARN
-    #: a large centred banner (game over, end of trace)
+    #: a banner panel at the top of the map (end of trace)
     banner: str | None = None
     banner_sub: str = ""
     #: extra HUD items on the first row
     info: Sequence[str] = field(default_factory=tuple)
     #: the second HUD row shows the overlay legend (play) or nothing (replay)
     legend: bool = True
+    #: a screen over the map (ready, won / lost, level chooser); wins over ``banner``
+    panel: Panel | None = None
+    #: collectibles still to pick up ``(k, 2)``
+    collectibles: np.ndarray = field(default_factory=lambda: np.zeros((0, 2)))
+    #: extra drawing after the cones (noise rings, rain): ``effects(surface, renderer)``
+    effects: Callable[[pygame.Surface, Renderer], None] | None = None
 
 
 @dataclass(frozen=True)
@@ -139,7 +98,8 @@ class Renderer:
     HELP_LINE = 18
     MARGIN = 8
 
-    def __init__(self, static: StaticScene, size: tuple[int, int]) -> None:
+    def __init__(self, static: StaticScene, size: tuple[int, int],
+                 camera: Camera | None = None) -> None:
         self.static = static
         self.font = pygame.font.Font(None, 22)
         self.small = pygame.font.Font(None, 18)
@@ -147,45 +107,68 @@ class Renderer:
         self._text_cache: dict[tuple[str, int, Color], pygame.Surface] = {}
         self._help_key: tuple[int, tuple[str, ...]] | None = None
         self._help_lines: list[str] = []
-        self._base: pygame.Surface | None = None
-        self._composite: pygame.Surface | None = None
-        self._composite_key: tuple[object, bool] | None = None
-        self._composite_layer: object = None
         self._legend_bar: tuple[tuple[int, float, float], pygame.Surface] | None = None
         self._help_count = 2
-        self.layout = self._layout(size, self._help_count)
-        self._prepare()
+        self.layers = StaticLayers(static)
+        self.minimap = Minimap(static)
+        self.camera = camera or Camera()
+        self._size = (max(size[0], 200), max(size[1], 200))
+        if self.camera.zoom is None and self.fit_scale() < MIN_FIT_SCALE:
+            self.camera.zoom = START_SCALE  # a large level: start zoomed in, following
+        self.layout = self._layout(self._size, self._help_count)
 
     # ------------------------------------------------------------------ geometry
-    def _layout(self, size: tuple[int, int], help_lines: int) -> Layout:
-        w, h = max(size[0], 200), max(size[1], 200)
+    def _area(self, size: tuple[int, int], help_lines: int) -> tuple[int, int, int, int]:
+        w, h = size
         hud, helph = self.HUD_HEIGHT, help_lines * self.HELP_LINE + 6
+        return w, h, hud, helph
+
+    def fit_scale(self, size: tuple[int, int] | None = None) -> float:
+        """The px per world unit that shows the whole level in the window."""
+        w, h, hud, helph = self._area(size or self._size, self._help_count)
         avail_w = w - 2 * self.MARGIN
         avail_h = h - hud - helph - 2 * self.MARGIN
-        s = max(1e-3, min(avail_w / self.static.width, avail_h / self.static.height))
-        ox = (w - s * self.static.width) / 2
-        oy = hud + self.MARGIN + (avail_h - s * self.static.height) / 2
-        return Layout((w, h), hud, helph, s, (ox, oy))
+        return max(1e-3, min(avail_w / self.static.width, avail_h / self.static.height))
+
+    def _layout(self, size: tuple[int, int], help_lines: int) -> Layout:
+        w, h, hud, helph = self._area(size, help_lines)
+        fit = self.fit_scale(size)
+        s = self.camera.scale(fit)
+        avail_h = h - hud - helph - 2 * self.MARGIN
+        if self.camera.zoom is None:
+            ox = (w - s * self.static.width) / 2
+            oy = hud + self.MARGIN + (avail_h - s * self.static.height) / 2
+        else:
+            view_w, view_h = w / s, (h - hud - helph) / s
+            cx, cy = self.camera.center
+            cx = _clamp(cx, view_w / 2, self.static.width - view_w / 2)
+            cy = _clamp(cy, view_h / 2, self.static.height - view_h / 2)
+            ox = w / 2 - cx * s
+            oy = hud + (h - hud - helph) / 2 - cy * s
+        return Layout((w, h), hud, helph, s, (round(ox), round(oy)))
 
     def resize(self, size: tuple[int, int]) -> None:
-        """Adopt a new window size (recomputes the transform and the cached layers)."""
-        self.layout = self._layout(size, self._help_count)
+        """Adopt a new window size (recomputes the transform; the cache follows)."""
+        self._size = (max(size[0], 200), max(size[1], 200))
+        self.layout = self._layout(self._size, self._help_count)
         self._help_key = None
-        self._prepare()
 
-    def _prepare(self) -> None:
-        s, (ox, oy) = self.layout.scale, self.layout.origin
-        self._base = None
-        self._composite_key = None
-        self._mesh_layer: pygame.Surface | None = None
-        self._top_layer: pygame.Surface | None = None
-        self._field_layer: pygame.Surface | None = None
-        self._tri_polys: list[list[tuple[float, float]]] = []
-        if self.static.triangles is not None:
-            pts = self.static.triangles * s + (ox, oy)
-            self._tri_polys = [[(float(x), float(y)) for x, y in tri] for tri in pts]
-        walls = self.static.walls * s + (ox, oy)
-        self._wall_lines = [((float(a[0]), float(a[1])), (float(b[0]), float(b[1]))) for a, b in walls]
+    def refresh_view(self) -> None:
+        """Recompute the transform after the camera moved or zoomed."""
+        self.layout = self._layout(self._size, self._help_count)
+
+    def visible(self) -> tuple[float, float, float, float]:
+        """The world rectangle the map area shows now, clipped to the level."""
+        rect = self.layout.world_rect
+        x0, y0 = self.to_world(rect.left, rect.top)
+        x1, y1 = self.to_world(rect.right, rect.bottom)
+        return (max(0.0, x0), max(0.0, y0), min(self.static.width, x1), min(self.static.height, y1))
+
+    @property
+    def zoomed(self) -> bool:
+        """Whether the window shows only part of the level (then the minimap is drawn)."""
+        x0, y0, x1, y1 = self.visible()
+        return x0 > 1e-6 or y0 > 1e-6 or x1 < self.static.width - 1e-6 or y1 < self.static.height - 1e-6
 
     def to_screen(self, x: float, y: float) -> tuple[float, float]:
         """World point → window pixel."""
@@ -197,117 +180,10 @@ class Renderer:
         s, (ox, oy) = self.layout.scale, self.layout.origin
         return ((px - ox) / s, (py - oy) / s)
 
-    def _pts(self, points: np.ndarray) -> list[tuple[float, float]]:
+    def _pts(self, points: np.ndarray) -> list[list[float]]:
         s, (ox, oy) = self.layout.scale, self.layout.origin
-        return [(ox + x * s, oy + y * s) for x, y in np.asarray(points, dtype=float).reshape(-1, 2)]
-
-    # ------------------------------------------------------------------ cached layers
-    def _base_surface(self) -> pygame.Surface:
-        """Floor and zones: depends on the window size only."""
-        if self._base is not None:
-            return self._base
-        surface = pygame.Surface(self.layout.size).convert()
-        surface.fill(BACKGROUND)
-        world = pygame.Rect(
-            round(self.layout.origin[0]), round(self.layout.origin[1]),
-            round(self.static.width * self.layout.scale), round(self.static.height * self.layout.scale),
-        )
-        surface.fill(BLOCKED, world)
-        outline, *holes = self.static.floor
-        pygame.draw.polygon(surface, FLOOR, self._pts(outline))
-        for hole in holes:
-            pygame.draw.polygon(surface, BLOCKED, self._pts(hole))
-        for kind, polygons in self.static.zones.items():
-            for exterior, *_ in polygons:
-                pygame.draw.polygon(surface, ZONE_FILL.get(kind, FLOOR), self._pts(exterior))
-        for hole in holes:  # a zone clipped to the floor has the obstacles as its holes
-            pygame.draw.polygon(surface, BLOCKED, self._pts(hole))
-        self._base = surface
-        return surface
-
-    def _lines_layer(self, draw: Callable[[pygame.Surface], None]) -> pygame.Surface:
-        """A window-sized colour-keyed layer (fast sparse blits) holding what ``draw`` draws."""
-        surface = pygame.Surface(self.layout.size).convert()
-        surface.fill(_KEY)
-        draw(surface)
-        surface.set_colorkey(_KEY, pygame.RLEACCEL)
-        return surface
-
-    def _draw_top(self, surface: pygame.Surface) -> None:
-        """Zone outlines, walls and static decoys: drawn over the field overlay."""
-        for kind, polygons in self.static.zones.items():
-            for exterior, *_ in polygons:
-                pygame.draw.lines(surface, ZONE_EDGE.get(kind, TEXT_DIM), True, self._pts(exterior), 1)
-        wall_width = max(2, round(self.layout.scale * 0.12))
-        for a, b in self._wall_lines:
-            pygame.draw.line(surface, WALL, a, b, wall_width)
-        width = max(1, round(self.layout.scale * 0.08))
-        for x, y in self.static.decoys:
-            self._diamond(surface, self.to_screen(x, y), max(4, self.layout.scale * 0.3), DECOY, width)
-
-    def _composite_surface(self, scene: Scene, options: DrawOptions) -> pygame.Surface:
-        """Base + field overlay + grid/mesh lines + zone outlines + walls + static decoys.
-
-        Rebuilt only when the field layer (once per AI tick), the mesh option or the window
-        size changes; the line layers themselves are drawn once per window size.
-        """
-        layer = scene.layer
-        key = (id(layer) if layer is not None else None, options.show_mesh)
-        if self._composite is not None and key == self._composite_key and self._composite_layer is layer:
-            return self._composite
-        base = self._base_surface()
-        surface = self._composite
-        if surface is None or surface.get_size() != base.get_size():
-            surface = pygame.Surface(base.get_size()).convert()
-        surface.blit(base, (0, 0))
-        if layer is not None:
-            self._draw_field(surface, layer.norm)
-        if options.show_mesh:
-            if self._mesh_layer is None:
-                self._mesh_layer = self._lines_layer(self._draw_mesh)
-            surface.blit(self._mesh_layer, (0, 0))
-        if self._top_layer is None:
-            self._top_layer = self._lines_layer(self._draw_top)
-        surface.blit(self._top_layer, (0, 0))
-        self._composite, self._composite_key, self._composite_layer = surface, key, layer
-        return surface
-
-    def _draw_field(self, surface: pygame.Surface, norm: np.ndarray) -> None:
-        """Colour every node's cell (grid) or triangle (partition) by its normalised value."""
-        rgb = colors_of(norm)
-        s, (ox, oy) = self.layout.scale, self.layout.origin
-        if self.static.cell_node is not None:
-            # One pixel per cell, then scaled up: the whole overlay is two blits.
-            cell_node = self.static.cell_node
-            rows, cols = cell_node.shape
-            image = np.zeros((rows, cols, 4), dtype=np.uint8)
-            inside = cell_node >= 0
-            image[inside, :3] = rgb[cell_node[inside]]
-            image[inside, 3] = OVERLAY_ALPHA
-            # convert_alpha: a display-format surface blits ~30x faster than raw RGBA.
-            small = pygame.image.frombuffer(image.tobytes(), (cols, rows), "RGBA").convert_alpha()
-            cell = self.static.cell_size * s
-            big = pygame.transform.scale(small, (round(cols * cell), round(rows * cell)))
-            surface.blit(big, (round(ox), round(oy)))
-        elif self._tri_polys:
-            if self._field_layer is None:
-                self._field_layer = pygame.Surface(self.layout.size, pygame.SRCALPHA).convert_alpha()
-            layer = self._field_layer
-            layer.fill((0, 0, 0, 0))
-            for poly, (r, g, b) in zip(self._tri_polys, rgb.tolist()):
-                pygame.draw.polygon(layer, (r, g, b, OVERLAY_ALPHA), poly)
-            surface.blit(layer, (0, 0))
-
-    def _draw_mesh(self, surface: pygame.Surface) -> None:
-        if self._tri_polys:
-            for poly in self._tri_polys:
-                pygame.draw.lines(surface, MESH, True, poly, 1)
-            return
-        s, (ox, oy) = self.layout.scale, self.layout.origin
-        cell = self.static.cell_size * s
-        for r, c in np.argwhere(self.static.occupancy):
-            rect = pygame.Rect(round(ox + c * cell), round(oy + r * cell), round(cell) + 1, round(cell) + 1)
-            pygame.draw.rect(surface, MESH, rect, 1)
+        pts = np.asarray(points, dtype=float).reshape(-1, 2) * s + (ox, oy)
+        return pts.tolist()
 
     # ------------------------------------------------------------------ the frame
     def draw(self, surface: pygame.Surface, scene: Scene, options: DrawOptions | None = None) -> None:
@@ -316,12 +192,26 @@ class Renderer:
         if surface.get_size() != self.layout.size:
             self.resize(surface.get_size())
         self._wrap_help(options.help)
-        surface.blit(self._composite_surface(scene, options), (0, 0))
+        area = self.layout.world_rect
+        surface.fill(BACKGROUND)
+        static, region = self.layers.surface(self.visible(), self.layout.scale, scene.layer,
+                                             options.show_mesh)
+        sx, sy = self.to_screen(region.x0, region.y0)
+        surface.set_clip(area)
+        surface.blit(static, (round(sx), round(sy)))
         s = self.layout.scale
         for x, y in scene.markers:
-            self._diamond(surface, self.to_screen(x, y), max(4, s * 0.3), MARKER, 0)
+            self._diamond(surface, self.to_screen(x, y), max(6, s * 0.35), MARKER, 0)
+        for x, y in options.collectibles:
+            self._collectible(surface, self.to_screen(x, y), max(6.0, s * 0.35))
         for guard in scene.guards:
             self._draw_cone(surface, guard)
+        for ring in self.static.exits:
+            x, y = self.to_screen(float(ring[:, 0].min()), float(ring[:, 1].min()))
+            label = self._text("EXIT", self.small, EXIT_EDGE)
+            surface.blit(label, (round(x) + 4, round(y) + 3))
+        if options.effects is not None:
+            options.effects(surface, self)
         if options.show_plans:
             for i, guard in enumerate(scene.guards):
                 self._draw_plan(surface, guard, PLAN_COLORS[i % len(PLAN_COLORS)])
@@ -331,12 +221,20 @@ class Renderer:
             for i, guard in enumerate(scene.guards):
                 self._draw_target(surface, guard, PLAN_COLORS[i % len(PLAN_COLORS)])
         self._draw_player(surface, scene)
+        for guard in scene.guards:
+            self._draw_label(surface, guard, scene)
+        if self.zoomed:
+            self.minimap.draw(surface, area.bottomright, scene, self.visible())
+        surface.set_clip(None)
         self._draw_hud(surface, scene, options)
         self._draw_help(surface)
-        if options.banner:
-            self._draw_banner(surface, options.banner, options.banner_sub)
+        player = self.to_screen(*scene.player.pos)
+        if options.panel is not None:
+            draw_panel(surface, area, options.panel, avoid=player)
+        elif options.banner:
+            draw_panel(surface, area, Panel(options.banner, (options.banner_sub,)), avoid=player)
         elif options.paused:
-            self._draw_banner(surface, "PAUSED", "Space to continue")
+            draw_panel(surface, area, Panel("PAUSED", ("Space to continue",), where="corner"))
 
     def _draw_cone(self, surface: pygame.Surface, guard: GuardDrawing) -> None:
         if not guard.active or len(guard.cone) < 3:
@@ -344,37 +242,51 @@ class Renderer:
         pts = np.asarray(self._pts(guard.cone))
         lo = np.floor(pts.min(axis=0)).astype(int)
         hi = np.ceil(pts.max(axis=0)).astype(int) + 1
+        area = self.layout.world_rect
+        if hi[0] < area.left or hi[1] < area.top or lo[0] > area.right or lo[1] > area.bottom:
+            return  # off screen
         size = (max(1, hi[0] - lo[0]), max(1, hi[1] - lo[1]))
         layer = pygame.Surface(size, pygame.SRCALPHA)
-        local = [(float(x), float(y)) for x, y in pts - lo]
+        local = (pts - lo).tolist()
         pygame.draw.polygon(layer, CONE_SEEING if guard.sees_player else CONE, local)
         surface.blit(layer, (int(lo[0]), int(lo[1])))
         edge = CONE_SEEING_EDGE if guard.sees_player else CONE_EDGE
-        pygame.draw.lines(surface, edge, True, [tuple(p) for p in pts.tolist()], 1)
+        outline = pts.tolist()
+        pygame.draw.lines(surface, HALO, True, outline, 4)
+        pygame.draw.lines(surface, edge, True, outline, 2)
 
     def _draw_plan(self, surface: pygame.Surface, guard: GuardDrawing, color: Color) -> None:
         if not guard.active:
             return
         s = self.layout.scale
+        width = max(2, round(s * 0.1))
         if len(guard.path):
-            pts = [self.to_screen(*guard.pos)] + self._pts(guard.path)
-            pygame.draw.lines(surface, color, False, pts, max(2, round(s * 0.08)))
+            pts = [list(self.to_screen(*guard.pos))] + self._pts(guard.path)
+            pygame.draw.lines(surface, HALO, False, pts, width + 2)
+            pygame.draw.lines(surface, color, False, pts, width)
+        r = max(6.0, s * 0.28)
         for x, y in guard.candidates:
-            pygame.draw.circle(surface, color, self.to_screen(x, y), max(3, s * 0.15), 1)
+            c = self.to_screen(x, y)
+            pygame.draw.circle(surface, HALO, c, r + 1, 4)
+            pygame.draw.circle(surface, color, c, r, 2)
         if guard.chosen is not None:
-            pygame.draw.circle(surface, color, self.to_screen(*guard.chosen), max(3, s * 0.15))
+            c = self.to_screen(*guard.chosen)
+            pygame.draw.circle(surface, HALO, c, r + 1)
+            pygame.draw.circle(surface, color, c, r)
 
     def _draw_target(self, surface: pygame.Surface, guard: GuardDrawing, color: Color) -> None:
         """A square frame around the target node, larger than a body so it shows around one."""
         if guard.active and guard.target is not None:
             cx, cy = self.to_screen(*guard.target)
-            half = max(6, self.layout.scale * 0.45)
-            pygame.draw.rect(surface, color, pygame.Rect(cx - half, cy - half, 2 * half, 2 * half), 2)
+            half = max(9, self.layout.scale * 0.55)
+            box = pygame.Rect(cx - half, cy - half, 2 * half, 2 * half)
+            pygame.draw.rect(surface, HALO, box.inflate(4, 4), 5)
+            pygame.draw.rect(surface, color, box, 3)
 
     def _draw_guard(self, surface: pygame.Surface, guard: GuardDrawing, scene: Scene) -> None:
         s = self.layout.scale
         center = self.to_screen(*guard.pos)
-        radius = max(4.0, scene.agent_radius * s)
+        radius = max(5.0, scene.agent_radius * s)
         if not guard.active:
             d = radius * 0.8
             cx, cy = center
@@ -389,23 +301,33 @@ class Renderer:
         hx, hy = np.cos(guard.heading), np.sin(guard.heading)
         tip = (center[0] + hx * radius * 1.7, center[1] + hy * radius * 1.7)
         pygame.draw.line(surface, (20, 20, 20), center, tip, 2)
-        if guard.state:
-            text = f"{guard.state} · {guard.role}" if guard.role else guard.state
-            label = self._text(text, self.small, TEXT)
-            surface.blit(label, (center[0] - label.get_width() / 2, center[1] + radius + 1))
-        if guard.awareness is not None:  # graded perception: a meter above the guard
+        if guard.awareness is not None:  # graded perception: a meter below the guard
             frac = max(0.0, min(1.0, guard.awareness))
-            meter = pygame.Rect(round(center[0] - radius), round(center[1] - radius - 7),
+            meter = pygame.Rect(round(center[0] - radius), round(center[1] + radius + 3),
                                 round(2 * radius), 4)
             pygame.draw.rect(surface, (40, 40, 40), meter)
             pygame.draw.rect(surface, BAD if frac >= 1.0 else WARN,
                              (meter.x, meter.y, round(meter.w * frac), meter.h))
 
+    def _draw_label(self, surface: pygame.Surface, guard: GuardDrawing, scene: Scene) -> None:
+        """The behaviour label above the guard, on a dark box, drawn after every marker."""
+        if not guard.state:
+            return
+        center = self.to_screen(*guard.pos)
+        radius = max(5.0, scene.agent_radius * self.layout.scale)
+        text = f"{guard.state} · {guard.role}" if guard.role else guard.state
+        label = self._text(text, self.small, TEXT)
+        x = center[0] - label.get_width() / 2
+        y = center[1] - radius - label.get_height() - 4
+        box = pygame.Rect(round(x) - 3, round(y) - 1, label.get_width() + 6, label.get_height() + 2)
+        pygame.draw.rect(surface, HALO, box)
+        surface.blit(label, (round(x), round(y)))
+
     def _draw_player(self, surface: pygame.Surface, scene: Scene) -> None:
         s = self.layout.scale
         p = scene.player
         center = self.to_screen(*p.pos)
-        radius = max(4.0, scene.agent_radius * s)
+        radius = max(5.0, scene.agent_radius * s)
         color = PLAYER_SPRINT if p.sprinting else PLAYER
         if p.concealed:
             pygame.draw.circle(surface, color, center, radius, 2)
@@ -422,6 +344,14 @@ class Renderer:
     def _diamond(surface: pygame.Surface, c: tuple[float, float], r: float, color: Color, width: int) -> None:
         x, y = c
         pygame.draw.polygon(surface, color, [(x, y - r), (x + r, y), (x, y + r), (x - r, y)], width)
+
+    @staticmethod
+    def _collectible(surface: pygame.Surface, c: tuple[float, float], r: float) -> None:
+        x, y = c
+        star = [(x + r * np.cos(a) * (1 if k % 2 == 0 else 0.45), y + r * np.sin(a) * (1 if k % 2 == 0 else 0.45))
+                for k, a in enumerate(np.linspace(-np.pi / 2, 1.5 * np.pi, 10, endpoint=False))]
+        pygame.draw.polygon(surface, HALO, star, 4)
+        pygame.draw.polygon(surface, COLLECTIBLE, star)
 
     # ------------------------------------------------------------------ text
     def _text(self, text: str, font: pygame.font.Font, color: Color) -> pygame.Surface:
@@ -545,7 +475,6 @@ class Renderer:
         if len(lines) != self._help_count:
             self._help_count = len(lines)
             self.layout = self._layout(self.layout.size, self._help_count)
-            self._prepare()
 
     def _draw_help(self, surface: pygame.Surface) -> None:
         y = self.layout.size[1] - self.layout.help_height + 3
@@ -553,19 +482,14 @@ class Renderer:
             surface.blit(self._text(line, self.small, TEXT_DIM), (10, y))
             y += self.HELP_LINE
 
-    def _draw_banner(self, surface: pygame.Surface, title: str, sub: str) -> None:
-        w, h = self.layout.size
-        big = self._text(title, self.big, TEXT)
-        small = self._text(sub, self.font, TEXT) if sub else None
-        bw = max(big.get_width(), small.get_width() if small else 0) + 40
-        bh = big.get_height() + (small.get_height() + 8 if small else 0) + 24
-        box = pygame.Surface((bw, bh), pygame.SRCALPHA)
-        box.fill((0, 0, 0, 170))
-        x, y = (w - bw) // 2, (h - bh) // 2
-        surface.blit(box, (x, y))
-        surface.blit(big, ((w - big.get_width()) // 2, y + 12))
-        if small:
-            surface.blit(small, ((w - small.get_width()) // 2, y + 16 + big.get_height()))
+
+def _clamp(value: float, lo: float, hi: float) -> float:
+    """``value`` within [lo, hi] (the middle when the range is empty)."""
+    return (lo + hi) / 2 if lo > hi else min(max(value, lo), hi)
+
+
+#: How long an idle frame loop blocks waiting for input (so it still redraws ~4 times/s).
+IDLE_WAIT_MS = 250
 
 
 class FrameLoop:
@@ -596,6 +520,10 @@ class FrameLoop:
     def frame(self, elapsed: float) -> None:  # pragma: no cover - implemented by subclasses
         raise NotImplementedError
 
+    def idle(self) -> bool:
+        """Whether nothing moves without input (paused, ready screen): the loop then sleeps."""
+        return False
+
     def run(self, frames: int | None = None) -> list[float]:
         """Loop until Esc / window close (or ``frames`` frames); return each frame's seconds."""
         times: list[float] = []
@@ -604,15 +532,32 @@ class FrameLoop:
             start = time.perf_counter()
             self.frame(elapsed)
             times.append(time.perf_counter() - start)
-            elapsed = 0.0 if self.lockstep else self.clock.tick(60) / 1000.0
+            if self.lockstep:
+                elapsed = 0.0
+            elif self.idle():
+                # Sleep until an input arrives (at most IDLE_WAIT_MS): an idle game uses
+                # almost no CPU. The event goes back on the queue for the next frame.
+                event = pygame.event.wait(IDLE_WAIT_MS)
+                if event.type != pygame.NOEVENT:
+                    pygame.event.post(event)
+                self.clock.tick()
+                elapsed = 0.0
+            else:
+                elapsed = self.clock.tick(60) / 1000.0
         return times
 
 
+#: The largest window :func:`default_window_size` opens (a larger level gets the camera).
+MAX_WINDOW = (1280, 860)
+
+
 def default_window_size(static: StaticScene) -> tuple[int, int]:
-    """A window that shows the level at a comfortable scale (at least 960 px wide)."""
+    """A window that shows the level at a comfortable scale (at least 960 px wide, at most
+    :data:`MAX_WINDOW`: a level that does not fit is shown through the camera)."""
     s = max(14.0, min(40.0, min(1100 / static.width, 640 / static.height)))
-    return (max(960, round(static.width * s) + 2 * Renderer.MARGIN),
-            round(static.height * s) + Renderer.HUD_HEIGHT + 2 * Renderer.MARGIN + 3 * Renderer.HELP_LINE + 6)
+    chrome = Renderer.HUD_HEIGHT + 2 * Renderer.MARGIN + 3 * Renderer.HELP_LINE + 6
+    return (min(MAX_WINDOW[0], max(960, round(static.width * s) + 2 * Renderer.MARGIN)),
+            min(MAX_WINDOW[1], round(static.height * s) + chrome))
 
 
 def save_screenshot(surface: pygame.Surface, path: str) -> None:

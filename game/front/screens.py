@@ -1,0 +1,79 @@
+"""The game's screens as panels over the map: ready, paused, won / lost, level chooser,
+questionnaire.
+
+A :class:`Panel` is a title, a few lines and an optional highlighted choice. It is drawn
+along the top edge of the map area (or the right-hand corner, for the small paused panel),
+never over the map's centre, where the player and the guards usually are.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+
+import pygame
+
+from .palette import Color, TEXT, TEXT_DIM, WARN
+
+__all__ = ["Panel", "draw_panel"]
+
+
+@dataclass(frozen=True)
+class Panel:
+    """A screen's text: ``title`` big, then ``lines``; ``choice`` highlights one line."""
+
+    title: str
+    lines: Sequence[str] = ()
+    title_color: Color = TEXT
+    choice: int | None = None
+    #: ``"top"`` (a wide panel under the HUD) or ``"corner"`` (small, top right)
+    where: str = "top"
+    hint: str = ""
+    extra: tuple[str, ...] = field(default_factory=tuple)
+
+
+_FONTS: dict[int, pygame.font.Font] = {}
+
+
+def _font(size: int) -> pygame.font.Font:
+    font = _FONTS.get(size)
+    if font is None:
+        font = _FONTS[size] = pygame.font.Font(None, size)
+    return font
+
+
+def draw_panel(surface: pygame.Surface, area: pygame.Rect, panel: Panel,
+               avoid: tuple[float, float] | None = None) -> pygame.Rect:
+    """Draw ``panel`` inside the map ``area``; returns the box drawn.
+
+    A wide panel goes along the top edge, or along the bottom edge when the ``avoid``
+    point (the player on screen) is in the upper half, so it never hides the player."""
+    big = _font(46 if panel.where == "top" else 32)
+    small = _font(22)
+    title = big.render(panel.title, True, panel.title_color)
+    rows = []
+    for i, line in enumerate(panel.lines):
+        chosen = panel.choice == i
+        rows.append(small.render(("> " if chosen else "  ") + line if panel.choice is not None
+                                 else line, True, WARN if chosen else TEXT))
+    if panel.hint:
+        rows.append(small.render(panel.hint, True, TEXT_DIM))
+    width = max([title.get_width()] + [r.get_width() for r in rows]) + 36
+    height = title.get_height() + sum(r.get_height() + 3 for r in rows) + 26
+    if panel.where == "corner":
+        x, y = area.right - width - 10, area.top + 10
+    else:
+        x, y = area.centerx - width // 2, area.top + 10
+        if avoid is not None and avoid[1] < area.centery:
+            y = area.bottom - height - 10
+    box = pygame.Rect(x, y, width, height)
+    shade = pygame.Surface(box.size, pygame.SRCALPHA)
+    shade.fill((0, 0, 0, 200))
+    surface.blit(shade, box.topleft)
+    pygame.draw.rect(surface, panel.title_color, box, 2)
+    surface.blit(title, (x + 18, y + 10))
+    cy = y + 14 + title.get_height()
+    for row in rows:
+        surface.blit(row, (x + 18, cy))
+        cy += row.get_height() + 3
+    return box

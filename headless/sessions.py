@@ -1,0 +1,61 @@
+"""``stealth play --record DIR``: played sessions into a results store, next to the policies.
+
+Every finished session (a row from :mod:`game.record`, ``player = "human"``) is added to
+``DIR/results.sqlite`` and its trace written to ``DIR/sessions/<session>.jsonl`` (for
+``stealth replay``). For each session's level, abstraction, guards, scenario and seed the
+comparison policies (:data:`COMPARE`: MaxMin and SafetyGraph) are run once in the same
+interactive world and stored too, so ``stealth report DIR`` shows human and policy rows
+on the same level and seeds.
+"""
+
+from __future__ import annotations
+
+import re
+from collections.abc import Mapping, Sequence
+from pathlib import Path
+from typing import Any
+
+from game.config import Config
+from game.record import policy_row
+from game.trial import TrialSpec
+
+from .errors import UserError
+from .store import STORE_NAME, ResultStore
+
+__all__ = ["COMPARE", "SessionStore"]
+
+#: The player policies every recorded session is compared with.
+COMPARE: tuple[str, ...] = ("maxmin", "safetygraph")
+
+
+class SessionStore:
+    """Writes sessions (and their comparison trials) into one results directory."""
+
+    def __init__(self, directory: str | Path, overrides: Sequence[str] = ()) -> None:
+        self.directory = Path(directory)
+        try:
+            self.directory.mkdir(parents=True, exist_ok=True)
+            (self.directory / "sessions").mkdir(exist_ok=True)
+        except OSError as error:
+            raise UserError(f"--record {directory}: cannot create the folder ({error})") from None
+        self.overrides = tuple(overrides)
+        self.stored: list[str] = []
+
+    def __call__(self, row: Mapping[str, Any], trace: Sequence[str]) -> None:
+        """Store one session row, its trace, and the comparison policies' trials."""
+        name = re.sub(r"[^A-Za-z0-9_.=-]+", "_", str(row["key"]))
+        (self.directory / "sessions" / f"{name}.jsonl").write_text(
+            "".join(line + "\n" for line in trace), encoding="utf-8")
+        with ResultStore(self.directory / STORE_NAME) as store:
+            store.add(row)
+            done = store.done_keys()
+            config = Config.load({"world.spawns": "level"}).with_overrides(self.overrides)
+            for player in COMPARE:
+                spec = TrialSpec(
+                    level=str(row["level_ref"]), abstraction=str(row["abstraction"]),
+                    guards=str(row["guards"]), player=player, scenario=str(row["scenario"]),
+                    seed=int(row["seed"]), overrides=tuple(dict(row["overrides"]).items()),
+                )
+                if spec.key + "/interactive" not in done:
+                    store.add(policy_row(spec, config))
+        self.stored.append(str(row["key"]))
