@@ -48,7 +48,8 @@ class World(PlayerActions):
             raise ValueError(f"unknown scenario {scenario!r} (choose capture or fixed)")
         self.level, self.abstraction, self.scenario = level, abstraction, scenario
         self.config = config
-        self.graph: NodeGraph = graph if graph is not None else graph_for(level, abstraction)
+        self.graph: NodeGraph = graph if graph is not None else graph_for(
+            level, abstraction, float(config["world.agent_radius"]))
         self.guard_ai, self.player_policy = guard_ai, player_policy
         spawn_rng, guard_rng, player_rng = rngs or default_rngs(seed)
         self.spawn_rng = spawn_rng
