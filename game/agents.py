@@ -121,13 +121,20 @@ class Locomotion:
         shape.elasticity = 0.0
         self.space.add(body, shape)
         agent = Agent(body=body, speed=speed, node=node, target=node)
-        agent.place(self.node_point(node))
+        agent.place(self.stand_point(node))
         return agent
 
     def node_point(self, node: int) -> tuple[float, float]:
         """A node's position as a tuple of floats."""
         x, y = self.graph.positions[node]
         return (float(x), float(y))
+
+    def stand_point(self, node: int) -> tuple[float, float]:
+        """Where a body stands on ``node``: its position, or on the partition the nearest
+        point a body's centre may occupy (a triangle's centroid can lie by a wall)."""
+        if self.graph.mesh is None:
+            return self.node_point(node)
+        return self.body.snap(*self.node_point(node))
 
     def plan(self, agent: Agent, target: int) -> None:
         """Waypoints from the agent's position to ``target``'s node position."""

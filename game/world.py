@@ -130,7 +130,7 @@ class World(PlayerActions):
     def place_player(self, node: int, *, forget_detection: bool = False) -> None:
         """Teleport the player onto ``node`` (a respawn; scripted set-ups such as
         ``stealth mechanics``); ``forget_detection`` clears the first-detection time."""
-        self.player.place(self.locomotion.node_point(node))
+        self.player.place(self.locomotion.stand_point(node))
         self.player.node = node
         self.player.waypoints.clear()
         if forget_detection:
