@@ -8,6 +8,7 @@ re-plans another way, and ``stealth validate`` names passages narrower than a bo
 from __future__ import annotations
 
 import json
+from collections import deque
 import tomllib
 from importlib.resources import files
 from pathlib import Path
@@ -222,3 +223,24 @@ def test_bodies_keep_off_walls_and_keep_moving_on_random_levels(seed: int) -> No
             overlap, longest = _watch(level, abstraction, guards, seed)
             assert overlap <= TOL, f"{abstraction}/{guards}: a body {overlap:.3f} into a wall"
             assert longest <= 3.0, f"{abstraction}/{guards}: an agent stood still {longest:.1f} s"
+
+
+def test_a_stuck_agent_replans_another_way() -> None:
+    # The agent is sent straight at a cell behind a thin wall (the blocked line). Once stuck
+    # it must take the way round the wall's end, not wait for its controller to re-decide
+    # the same line. (A second timeout hands it back to the controller, as before.)
+    level = _level([[[2.95, 0], [3.05, 0], [3.05, 2.4], [2.95, 2.4]]])
+    graph = graph_for(level, "grid")
+    walk = Locomotion(build_space(level), graph, level, RADIUS, 0.05)
+    start, goal = int(graph.cell_node[0, 2]), int(graph.cell_node[0, 3])
+    agent = walk.make_agent(start, 2.0)
+    agent.target, agent.waypoints = goal, deque([walk.node_point(goal)])
+    crossed = False
+    for _ in range(int(8 / 0.05)):
+        before = agent.pos
+        walk.drive(agent, agent.speed)
+        walk.space.step(0.05)
+        walk.settle(agent, before, agent.speed, 3.0)
+        agent.node = graph.node_near(*agent.pos, agent.node)
+        crossed = crossed or agent.pos[0] > 3.05 + RADIUS
+    assert crossed, f"still stuck at {agent.pos} (waypoints {list(agent.waypoints)})"
