@@ -1,9 +1,11 @@
 """Agents and their locomotion: circle bodies walking to a target node along waypoints.
 
 The world asks a controller for a target node; :class:`Locomotion` turns it into waypoints
-(the neighbouring cell centre or the grid path on the grid, the funnel path with its corners
-moved off the walls on the partition), sets each body's velocity towards the next waypoint
-so it lands on it exactly, and pops the waypoints the body reached.
+(the neighbouring cell centre on the grid, whose moves are clear for the body; on the
+partition the funnel path through the walkable area eroded by the body radius, see
+:mod:`navmesh.clearance`), sets each body's velocity towards the next waypoint so it lands
+on it exactly, and pops the waypoints the body reached. A body stuck on a plan re-plans
+once from where it stands along the eroded area before its controller is asked again.
 """
 
 from __future__ import annotations
@@ -16,6 +18,7 @@ from typing import Any
 import numpy as np
 import pymunk
 
+from navmesh.clearance import clearance_for
 from navmesh.graph import NodeGraph
 from navmesh.level import Level
 
@@ -48,6 +51,8 @@ class Agent:
     cruise: tuple[tuple[float, float], float, float] | None = None
     #: whether the last physics step moved the body exactly as commanded (no wall contact)
     on_track: bool = False
+    #: whether the current plan is already a re-plan after being stuck (Locomotion.settle)
+    replanned: bool = False
 
     def sync(self) -> None:
         """Read the body's position after a physics step."""
@@ -105,6 +110,7 @@ class Locomotion:
                  dt: float) -> None:
         self.space, self.graph, self.level = space, graph, level
         self.radius, self.dt = radius, dt
+        self.body = clearance_for(level, radius)
 
     def make_agent(self, node: int, speed: float) -> Agent:
         """A body of the agent radius in the space, standing on ``node``'s position."""
@@ -115,7 +121,7 @@ class Locomotion:
         shape.elasticity = 0.0
         self.space.add(body, shape)
         agent = Agent(body=body, speed=speed, node=node, target=node)
-        agent.place(self.node_point(node))
+        agent.place(self.stand_point(node))
         return agent
 
     def node_point(self, node: int) -> tuple[float, float]:
@@ -123,19 +129,55 @@ class Locomotion:
         x, y = self.graph.positions[node]
         return (float(x), float(y))
 
+    def stand_point(self, node: int) -> tuple[float, float]:
+        """Where a body stands on ``node``: its position, or on the partition the nearest
+        point a body's centre may occupy (a triangle's centroid can lie by a wall)."""
+        if self.graph.mesh is None:
+            return self.node_point(node)
+        return self.body.snap(*self.node_point(node))
+
     def plan(self, agent: Agent, target: int) -> None:
         """Waypoints from the agent's position to ``target``'s node position."""
-        goal = tuple(self.graph.positions[target])
-        agent.target, agent.since_target = target, 0.0
-        if self.graph.mesh is None or target == agent.node:
-            agent.waypoints = deque([goal])
+        goal = self.node_point(target)
+        agent.target, agent.since_target, agent.replanned = target, 0.0, False
+        if self.graph.mesh is None:
+            agent.waypoints = deque(self._grid_start(agent) + [goal])
             return
-        if self.graph.kind == "grid":
-            path = self.graph.shortest_path(agent.node, target)
-            agent.waypoints = deque(tuple(self.graph.positions[v]) for v in path[1:])
+        path = self.body.path(agent.pos, goal)
+        if path:
+            agent.waypoints = deque(path)
+            return
+        # No body-wide way (the ends lie in pieces of the eroded area a body cannot join):
+        # the centre-line funnel path, corners moved off the walls.
+        if target == agent.node:
+            agent.waypoints = deque([goal])
             return
         points = self.graph.mesh.find_path(agent.pos, goal).points
         agent.waypoints = deque(self.clear_corners(points))
+
+    def _grid_start(self, agent: Agent) -> list[tuple[float, float]]:
+        """On the grid: [] when the body stands on its cell's centre (moves between centres
+        are clear), else the body-wide way back to that centre first."""
+        centre = self.node_point(agent.node)
+        x, y = agent.pos
+        if abs(x - centre[0]) < 1e-6 and abs(y - centre[1]) < 1e-6:
+            return []
+        if self.body.clear_move(agent.pos, centre):
+            return [centre]
+        return self.body.path(agent.pos, centre)[:-1] + [centre]
+
+    def replan(self, agent: Agent) -> None:
+        """A different way to the same target for a stuck agent: from where it stands, back
+        onto the body-wide network (grid: via its cell centre along the eroded area, then the
+        graph path; partition: the eroded-area path from its current position)."""
+        agent.since_target, agent.replanned, agent.cruise = 0.0, True, None
+        goal = self.node_point(agent.target)
+        if self.graph.mesh is None:
+            start = self._grid_start(agent)
+            path = self.graph.shortest_path(agent.node, agent.target)
+            agent.waypoints = deque(start + [self.node_point(v) for v in path[1:]] or [goal])
+            return
+        agent.waypoints = deque(self.body.path(agent.pos, goal) or [goal])
 
     def clear_corners(self, points: np.ndarray) -> list[tuple[float, float]]:
         """Move the funnel path's corner points one agent radius off the wall corner.
@@ -198,9 +240,9 @@ class Locomotion:
 
     def settle(self, agent: Agent, before: tuple[float, float], speed: float,
                stuck_timeout: float) -> bool:
-        """After a physics step: read the body, pop reached waypoints, and clear the plan of
-        an agent stuck for ``stuck_timeout`` s (it re-plans from where it stands). True when
-        the agent has just reached its target."""
+        """After a physics step: read the body, pop reached waypoints, and re-plan an agent
+        stuck for ``stuck_timeout`` s (:meth:`replan`; stuck again, its plan is cleared and
+        its controller decides anew). True when the agent has just reached its target."""
         agent.sync()
         x, y = agent.pos
         moved = math.hypot(x - before[0], y - before[1])
@@ -208,7 +250,10 @@ class Locomotion:
         agent.since_target += self.dt
         arrived = self.advance(agent, moved, speed * self.dt)
         if agent.waypoints and agent.since_target > stuck_timeout:
-            agent.waypoints.clear()
+            if agent.replanned:
+                agent.waypoints.clear()
+            else:
+                self.replan(agent)
         return arrived
 
     def advance(self, agent: Agent, moved: float, expected: float) -> bool:

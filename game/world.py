@@ -51,7 +51,8 @@ class World(PlayerActions):
         self.level, self.abstraction, self.scenario = level, abstraction, scenario
         check_level(config, level)  # a body too wide for the level's corridors: one line
         self.config = config
-        self.graph: NodeGraph = graph if graph is not None else graph_for(level, abstraction)
+        self.graph: NodeGraph = graph if graph is not None else graph_for(
+            level, abstraction, float(config["world.agent_radius"]))
         self.guard_ai, self.player_policy = guard_ai, player_policy
         spawn_rng, guard_rng, player_rng = rngs or default_rngs(seed)
         self.spawn_rng = spawn_rng
@@ -137,7 +138,7 @@ class World(PlayerActions):
     def place_player(self, node: int, *, forget_detection: bool = False) -> None:
         """Teleport the player onto ``node`` (a respawn; scripted set-ups such as
         ``stealth mechanics``); ``forget_detection`` clears the first-detection time."""
-        self.player.place(self.locomotion.node_point(node))
+        self.player.place(self.locomotion.stand_point(node))
         self.player.node = node
         self.player.waypoints.clear()
         if forget_detection:

@@ -19,6 +19,7 @@ import sqlite3
 import sys
 import traceback
 from collections.abc import Mapping, Sequence
+from pathlib import Path
 from typing import Any, NoReturn
 
 from ai import GUARD_MODES, PLAYER_POLICIES
@@ -133,9 +134,33 @@ def cmd_validate(args: argparse.Namespace) -> int:
             print(f"stealth: error: {error}", file=sys.stderr)
             failed += 1
         else:
+            if not _body_fits(name, level):
+                failed += 1
+                continue
             print(f"{name}: ok ({level.name}, {level.rows}x{level.cols}, "
                   f"{int(level.occupancy.sum())} walkable cells)", file=sys.stderr)
     return EXIT_USER_ERROR if failed else 0
+
+
+def _body_fits(name: str, level: Any) -> bool:
+    """Warn of passages narrower than an agent (``world.agent_radius``); False, after one
+    error line, when the walkable area is disconnected for its body."""
+    from game.config import Config
+    from navmesh.clearance import clearance_for
+
+    radius = float(Config.defaults()["world.agent_radius"])
+    report = clearance_for(level, radius).report()
+    src = Path(name).name if Path(name).suffix else name
+    for x, y in report.narrow:
+        print(f"{src}: warning: passage narrower than {2 * radius:g} units near ({x:.1f}, {y:.1f})",
+              file=sys.stderr)
+    if report.connected:
+        return True
+    where = ", ".join(f"({x:.1f}, {y:.1f})" for x, y in report.piece_points[:4])
+    print(f"stealth: error: {src}: walkable area: an agent of radius {radius:g} cannot reach "
+          f"the whole level: it is in {len(report.pieces)} pieces for its body (near {where})",
+          file=sys.stderr)
+    return False
 
 
 # ---------------------------------------------------------------------- path

@@ -26,6 +26,8 @@ import numpy as np
 from scipy.sparse import csr_matrix
 from scipy.sparse.csgraph import connected_components, dijkstra, shortest_path
 
+from .clearance import DEFAULT_AGENT_RADIUS, clearance_for
+
 if TYPE_CHECKING:
     from .level import Level
     from .mesh import NavMesh
@@ -191,8 +193,14 @@ class NodeGraph:
 
     # ------------------------------------------------------------------ construction
     @classmethod
-    def from_grid(cls, occupancy: np.ndarray, cell_size: float, dense: bool | None = None) -> NodeGraph:
-        """Walkable cells as nodes (row-major order), 4-neighbourhood, cell-centre positions."""
+    def from_grid(cls, occupancy: np.ndarray, cell_size: float, dense: bool | None = None,
+                  moves: tuple[np.ndarray, np.ndarray] | None = None) -> NodeGraph:
+        """Walkable cells as nodes (row-major order), 4-neighbourhood, cell-centre positions.
+
+        ``moves``: (right, down) boolean arrays of the occupancy's shape saying whether the
+        move to the cell on the right / below is clear for a body
+        (:class:`navmesh.clearance.Clearance`); without it every pair of walkable cells is.
+        """
         occupancy = np.asarray(occupancy, dtype=bool)
         node_cell = np.argwhere(occupancy)
         cell_node = np.full(occupancy.shape, -1, dtype=np.int64)
@@ -203,6 +211,11 @@ class NodeGraph:
         around = np.stack(
             [padded[r - 1, c], padded[r + 1, c], padded[r, c - 1], padded[r, c + 1]], axis=1
         )
+        if moves is not None:
+            right, down = (np.pad(np.asarray(m, dtype=bool), 1) for m in moves)
+            clear = np.stack(
+                [down[r - 1, c], down[r, c], right[r, c - 1], right[r, c]], axis=1)
+            around = np.where(clear, around, -1)
         positions = (node_cell[:, ::-1] + 0.5) * cell_size
         return cls(
             kind="grid",
@@ -533,10 +546,19 @@ def dense_bytes(n_nodes: int) -> int:
     return 16 * n_nodes * n_nodes
 
 
-def build_graph(level: Level, abstraction: str) -> NodeGraph:
-    """Build the node graph of ``level`` in ``abstraction`` ("grid" or "partition")."""
+def build_graph(level: Level, abstraction: str,
+                radius: float = DEFAULT_AGENT_RADIUS) -> NodeGraph:
+    """Build the node graph of ``level`` in ``abstraction`` ("grid" or "partition").
+
+    On the grid only cells a body of ``radius`` can reach are nodes, joined where the
+    move is clear for it (:mod:`navmesh.clearance`); radius 0 is the bare cell grid.
+    """
     if abstraction == "grid":
-        return NodeGraph.from_grid(level.occupancy, level.cell_size)
+        if radius <= 0:
+            return NodeGraph.from_grid(level.occupancy, level.cell_size)
+        body = clearance_for(level, radius)
+        return NodeGraph.from_grid(body.grid_cells, level.cell_size,
+                                   moves=(body.right_clear, body.down_clear))
     if abstraction == "partition":
         from .mesh import NavMesh
 
@@ -550,23 +572,26 @@ class _GraphKey:
 
     digest: str
     abstraction: str
+    radius: float
     level: Level = field(compare=False, repr=False)
 
 
 @lru_cache(maxsize=32)
 def _cached_graph(key: _GraphKey) -> NodeGraph:
-    return build_graph(key.level, key.abstraction)
+    return build_graph(key.level, key.abstraction, key.radius)
 
 
-def graph_for(level: Level, abstraction: str) -> NodeGraph:
-    """The node graph of a level, cached per process on the level's content (``Level.digest``).
+def graph_for(level: Level, abstraction: str,
+              radius: float = DEFAULT_AGENT_RADIUS) -> NodeGraph:
+    """The node graph of a level for a body of ``radius`` (``world.agent_radius``), cached
+    per process on the level's content (``Level.digest``), abstraction and radius.
 
     The graph is always built from the level given, so it matches it even when the file
     changed since; levels built in memory (no digest) are not cached.
     """
     if level.digest is not None:
-        return _cached_graph(_GraphKey(level.digest, abstraction, level))
-    return build_graph(level, abstraction)
+        return _cached_graph(_GraphKey(level.digest, abstraction, float(radius), level))
+    return build_graph(level, abstraction, radius)
 
 
 #: Bytes a graph needs per node beyond dense matrices, measured with margin: CSR adjacency

@@ -1,0 +1,242 @@
+"""Body clearance: where a disc of the agent radius fits in a level's walkable area.
+
+Agents are discs of radius r, not points. :class:`Clearance` answers the questions the
+graph, the paths and ``stealth validate`` ask about that body: which grid moves are clear
+(the disc swept along the centre-to-centre segment stays in the walkable area), the
+walkable area eroded by r (Recast's agent-radius erosion) with its own navmesh for paths,
+the nearest point a body centre may occupy, and where passages are narrower than the body.
+
+>>> from shapely import box
+>>> from navmesh.level import parse_level
+>>> level = parse_level({"format": "stealth-level/1", "name": "thin",
+...     "outline": [[0, 0], [4, 0], [4, 2], [0, 2]],
+...     "obstacles": [[[1.95, 0], [2.05, 0], [2.05, 1.2], [1.95, 1.2]]],
+...     "guards": [[0.5, 0.5]]})
+>>> body = Clearance(level, 0.3)
+>>> bool(level.occupancy[0, 1] and level.occupancy[0, 2]), bool(body.right_clear[0, 1])
+(True, False)
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from functools import cached_property, lru_cache
+from typing import TYPE_CHECKING
+
+import numpy as np
+import shapely
+from shapely.geometry import Point, Polygon
+from shapely.geometry.base import BaseGeometry
+from shapely.ops import nearest_points
+
+if TYPE_CHECKING:
+    from navmesh.level import Level
+    from navmesh.mesh import NavMesh
+
+__all__ = ["DEFAULT_AGENT_RADIUS", "PATH_MARGIN", "BodyReport", "Clearance", "clearance_for"]
+
+#: ``world.agent_radius`` of game/defaults.toml (tests/test_bounds_geometry.py checks they
+#: agree): the body graphs are built for when a caller has no config at hand.
+DEFAULT_AGENT_RADIUS = 0.3
+#: Paths keep this much more than the radius from walls, so a body following one exactly
+#: never touches a wall (pymunk would push it back by its collision slop).
+PATH_MARGIN = 0.01
+#: Pieces and narrow spots smaller than this (area, world units²) are numerical dust.
+_AREA_EPS = 1e-4
+
+
+@dataclass(frozen=True)
+class BodyReport:
+    """What ``stealth validate`` says about a level for one body radius.
+
+    ``narrow``: a point near every passage narrower than the body's diameter (warnings);
+    ``pieces``: the areas of the eroded walkable area's pieces, largest first — more than
+    one means a body cannot reach the whole level (an error).
+    """
+
+    radius: float
+    narrow: tuple[tuple[float, float], ...]
+    pieces: tuple[float, ...]
+    piece_points: tuple[tuple[float, float], ...] = field(default=())
+
+    @property
+    def connected(self) -> bool:
+        """Whether one body can reach every part of the eroded walkable area."""
+        return len(self.pieces) <= 1
+
+
+class Clearance:
+    """A level seen by a disc body of ``radius``: clear grid moves, eroded area and mesh."""
+
+    def __init__(self, level: Level, radius: float) -> None:
+        self.level, self.radius = level, float(radius)
+        rows, cols = level.occupancy.shape
+        self.right_clear = np.zeros((rows, cols), dtype=bool)
+        self.down_clear = np.zeros((rows, cols), dtype=bool)
+        occ = level.occupancy
+        right = occ[:, :-1] & occ[:, 1:]
+        down = occ[:-1, :] & occ[1:, :]
+        self.right_clear[:, :-1] = right
+        self.down_clear[:-1, :] = down
+        for mask, (dr, dc) in ((self.right_clear, (0, 1)), (self.down_clear, (1, 0))):
+            r, c = np.nonzero(mask)
+            if r.size:
+                a = (np.column_stack([c, r]) + 0.5) * level.cell_size
+                b = (np.column_stack([c + dc, r + dr]) + 0.5) * level.cell_size
+                mask[r, c] = self.clear_moves(a, b)
+
+    # ------------------------------------------------------------------ swept-disc test
+    @cached_property
+    def _walls(self) -> shapely.STRtree:
+        segments = shapely.linestrings(np.asarray(self.level.walls, dtype=np.float64))
+        return shapely.STRtree(segments)
+
+    def clear_moves(self, a: np.ndarray, b: np.ndarray) -> np.ndarray:
+        """Whether the disc swept from each ``a[i]`` to ``b[i]`` stays in the walkable area.
+
+        Both ends must be walkable points; then the sweep is clear exactly when no wall
+        comes closer to the segment than the radius (a wall crossing it has distance 0).
+        """
+        a, b = np.asarray(a, dtype=np.float64), np.asarray(b, dtype=np.float64)
+        inside = shapely.intersects_xy(self.level.walkable, a[:, 0], a[:, 1]) & \
+            shapely.intersects_xy(self.level.walkable, b[:, 0], b[:, 1])
+        moves = shapely.linestrings(np.stack([a, b], axis=1))
+        hit, _ = self._walls.query(moves, predicate="dwithin", distance=self.radius * (1 - 1e-9))
+        clear = inside.copy()
+        clear[hit] = False
+        return clear
+
+    def clear_move(self, a: tuple[float, float], b: tuple[float, float]) -> bool:
+        """:meth:`clear_moves` for one segment."""
+        return bool(self.clear_moves(np.array([a]), np.array([b]))[0])
+
+    # ------------------------------------------------------------------ grid
+    @cached_property
+    def grid_cells(self) -> np.ndarray:
+        """Walkable cells a body can stand on and move between: the largest group of cells
+        joined by clear moves (a cell with no clear move, or cut off, is left out)."""
+        occ = self.level.occupancy
+        rows, cols = occ.shape
+        index = np.arange(rows * cols).reshape(rows, cols)
+        r1, c1 = np.nonzero(self.right_clear)
+        r2, c2 = np.nonzero(self.down_clear)
+        src = np.concatenate([index[r1, c1], index[r2, c2]])
+        dst = np.concatenate([index[r1, c1 + 1], index[r2 + 1, c2]])
+        if src.size == 0:  # no clear move at all: keep the level's cells (one-cell levels)
+            return occ.copy()
+        from scipy.sparse import coo_matrix
+        from scipy.sparse.csgraph import connected_components
+
+        graph = coo_matrix((np.ones(src.size), (src, dst)), shape=(rows * cols, rows * cols))
+        _, labels = connected_components(graph, directed=False)
+        joined = np.zeros(rows * cols, dtype=bool)
+        joined[src] = joined[dst] = True
+        sizes = np.bincount(labels[joined], minlength=labels.max() + 1)
+        return (labels == int(np.argmax(sizes))).reshape(rows, cols) & joined.reshape(rows, cols)
+
+    # ------------------------------------------------------------------ eroded area, paths
+    def eroded(self, radius: float) -> BaseGeometry:
+        """The walkable area eroded by ``radius`` (mitre joins: never closer than it to a wall)."""
+        return self.level.walkable.buffer(-radius, join_style="mitre")
+
+    @cached_property
+    def path_area(self) -> Polygon:
+        """Where paths run: the largest piece of the area eroded by radius + PATH_MARGIN."""
+        pieces = [g for g in shapely.get_parts(self.eroded(self.radius + PATH_MARGIN))
+                  if isinstance(g, Polygon) and g.area > _AREA_EPS]
+        if not pieces:
+            return Polygon()
+        from shapely.geometry.polygon import orient
+
+        piece = max(pieces, key=lambda g: g.area)
+        piece = orient(shapely.simplify(piece, 0.0), sign=1.0)
+        shapely.prepare(piece)
+        return piece
+
+    @cached_property
+    def _snap_area(self) -> BaseGeometry:
+        inner = self.path_area.buffer(-1e-6, join_style="mitre")
+        return inner if not inner.is_empty else self.path_area
+
+    @cached_property
+    def path_mesh(self) -> NavMesh | None:
+        """The navmesh of :attr:`path_area` (None when no body fits anywhere)."""
+        from navmesh.mesh import NavMesh
+
+        if self.path_area.is_empty:
+            return None
+        try:
+            return NavMesh.build(self.path_area)
+        except shapely.errors.GEOSException:  # GEOS's constrained Delaunay gives up on a few
+            return NavMesh.build(self.path_area, method="earcut", min_angle=20.0)
+
+    def snap(self, x: float, y: float) -> tuple[float, float]:
+        """(x, y) itself when a body centre may stand there; else the nearest point that may."""
+        if self.path_area.is_empty or shapely.intersects_xy(self.path_area, x, y):
+            return (float(x), float(y))
+        _, near = nearest_points(Point(x, y), self._snap_area)
+        return (float(near.x), float(near.y))
+
+    def path(self, start: tuple[float, float], goal: tuple[float, float]) -> list[tuple[float, float]]:
+        """Waypoints (start excluded) of a path a body can follow from ``start`` to ``goal``.
+
+        Both ends are snapped into :attr:`path_area` first; the path runs on its mesh, so
+        every corner keeps radius + PATH_MARGIN from the walls. Empty if there is none.
+        """
+        mesh = self.path_mesh
+        if mesh is None:
+            return []
+        a, b = self.snap(*start), self.snap(*goal)
+        try:
+            points = mesh.find_path(a, b).points
+        except ValueError:  # OutsideError (a snapped point on a dust piece), no corridor
+            return []
+        out = [(float(x), float(y)) for x, y in points[1:]]
+        if a != (float(start[0]), float(start[1])):
+            out.insert(0, a)  # step out of the wall's reach first
+        return out
+
+    # ------------------------------------------------------------------ validation
+    def report(self) -> BodyReport:
+        """Narrow passages (warnings) and the pieces of the eroded area (error if several)."""
+        r = self.radius
+        eroded = self.eroded(r)
+        pieces = sorted((g for g in shapely.get_parts(eroded)
+                         if isinstance(g, Polygon) and g.area > _AREA_EPS),
+                        key=lambda g: -g.area)
+        opened = eroded.buffer(r, join_style="mitre")
+        lost = self.level.walkable.difference(opened)
+        narrow = []
+        for part in shapely.get_parts(lost):
+            if part.area <= _AREA_EPS:
+                continue
+            thin = part.buffer(-1e-3)
+            if thin.is_empty:  # a sliver along a wall, not a passage
+                continue
+            p = part.representative_point()
+            narrow.append((round(float(p.x), 1), round(float(p.y), 1)))
+        points = tuple((round(float(g.representative_point().x), 1),
+                        round(float(g.representative_point().y), 1)) for g in pieces)
+        return BodyReport(r, tuple(sorted(set(narrow))), tuple(g.area for g in pieces), points)
+
+
+@dataclass(frozen=True)
+class _Key:
+    """A level's content identity and a radius; carries (but is not keyed on) the level."""
+
+    digest: str
+    radius: float
+    level: Level = field(compare=False, repr=False)
+
+
+@lru_cache(maxsize=32)
+def _cached(key: _Key) -> Clearance:
+    return Clearance(key.level, key.radius)
+
+
+def clearance_for(level: Level, radius: float) -> Clearance:
+    """The :class:`Clearance` of a level and radius, cached per process on the level's
+    content (``Level.digest``); levels built in memory are not cached."""
+    if level.digest is not None:
+        return _cached(_Key(level.digest, float(radius), level))
+    return Clearance(level, radius)

@@ -1,0 +1,246 @@
+"""Issue 11, class 3: geometry that validates must be geometry a body can follow.
+
+Agents are discs of ``world.agent_radius``: the grid joins only cells a disc can move
+between, partition paths run on the walkable area eroded by the radius, a stuck agent
+re-plans another way, and ``stealth validate`` names passages narrower than a body.
+"""
+
+from __future__ import annotations
+
+import json
+from collections import deque
+import tomllib
+from importlib.resources import files
+from pathlib import Path
+
+import numpy as np
+import pytest
+import shapely
+
+from ai import make_guard_ai, make_player_policy
+from game.agents import Locomotion, build_space
+from game.config import Config
+from game.trial import player_params
+from game.world import World
+from navmesh.graph import graph_for
+from navmesh.level import Level, parse_level
+
+RADIUS = 0.3
+TOL = 0.02
+
+
+def _level(obstacles: list, width: float = 6, height: float = 4, name: str = "t",
+           guards: list | None = None) -> Level:
+    return parse_level({
+        "format": "stealth-level/1", "name": name,
+        "outline": [[0, 0], [width, 0], [width, height], [0, height]],
+        "obstacles": obstacles, "guards": guards or [[0.5, height - 0.5]],
+    })
+
+
+def _edge(graph, a: tuple[int, int], b: tuple[int, int]) -> bool:
+    u, v = graph.cell_node[a], graph.cell_node[b]
+    return bool(u >= 0 and v >= 0 and v in graph.neighbors[u])
+
+
+# ----------------------------------------------------------------------------- unit
+def test_a_thin_wall_between_two_cell_centres_gives_no_edge() -> None:
+    wall = [[2.95, 0], [3.05, 0], [3.05, 1.4], [2.95, 1.4]]  # between (2.5, .5) and (3.5, .5)
+    level = _level([wall])
+    assert level.occupancy[0, 2] and level.occupancy[0, 3]  # both centres are walkable
+    graph = graph_for(level, "grid")
+    assert not _edge(graph, (0, 2), (0, 3))
+    assert _edge(graph, (2, 2), (2, 3))  # below the wall the move is clear
+    assert np.isfinite(graph.dist).all()  # and the body-graph is still one piece
+
+
+def test_a_move_grazing_a_wall_closer_than_the_radius_gives_no_edge() -> None:
+    # A wall 0.2 below the line between two centres: a point passes, a 0.3 disc does not.
+    level = _level([[[2, 0.7], [4, 0.7], [4, 1.4], [2, 1.4]]])
+    graph = graph_for(level, "grid")
+    assert level.occupancy[0, 2] and level.occupancy[0, 3]
+    assert not _edge(graph, (0, 2), (0, 3))
+    assert _edge(graph_for(level, "grid", 0.15), (0, 2), (0, 3))  # a thinner body fits
+    assert graph_for(level, "grid") is not graph_for(level, "grid", 0.15)
+
+
+def test_the_default_radius_is_the_configs() -> None:
+    from navmesh.clearance import DEFAULT_AGENT_RADIUS
+
+    defaults = tomllib.loads((files("game") / "defaults.toml").read_text())
+    assert DEFAULT_AGENT_RADIUS == defaults["world"]["agent_radius"]
+
+
+def _touching_diamond() -> Level:
+    # A diamond whose top vertex touches the outline at (3, 0): a pinch of width zero.
+    return _level([[[3, 0], [3.6, 1.2], [3, 2.4], [2.4, 1.2]]])
+
+
+def test_an_obstacle_touching_the_outline_at_one_point_gives_no_pass_by_the_grid() -> None:
+    level = _touching_diamond()
+    assert level.occupancy[0, 2] and level.occupancy[0, 3]
+    assert not _edge(graph_for(level, "grid"), (0, 2), (0, 3))
+
+
+def _clearance(level: Level, points: list[tuple[float, float]]) -> float:
+    """Smallest distance from the polyline through ``points`` to any wall."""
+    line = shapely.LineString(points) if len(points) > 1 else shapely.Point(points[0])
+    return float(shapely.distance(level.walkable.boundary, line))
+
+
+def test_an_obstacle_touching_the_outline_at_one_point_gives_no_pass_by_the_partition() -> None:
+    level = _touching_diamond()
+    graph = graph_for(level, "partition")
+    walk = Locomotion(build_space(level), graph, level, RADIUS, 0.05)
+    start, goal = graph.node_at(2.0, 0.4), graph.node_at(4.0, 0.4)
+    agent = walk.make_agent(start, 2.0)
+    walk.plan(agent, goal)
+    route = [agent.pos, *agent.waypoints]
+    assert _clearance(level, route) >= RADIUS - TOL
+    assert shapely.LineString(route).length > 4.0  # around the diamond, not through its tip
+
+
+# ----------------------------------------------------------------------------- validate
+def _write(tmp_path: Path, name: str, obstacles: list) -> Path:
+    path = tmp_path / f"{name}.json"
+    path.write_text(json.dumps({
+        "format": "stealth-level/1", "name": name,
+        "outline": [[0, 0], [12, 0], [12, 8], [0, 8]],
+        "obstacles": obstacles, "guards": [[1, 1]],
+    }))
+    return path
+
+
+def _validate(capsys: pytest.CaptureFixture[str], *levels: str) -> tuple[int, str]:
+    from headless.cli import main
+
+    code = main(["validate", *levels])
+    return code, capsys.readouterr().err
+
+
+def test_validate_warns_of_a_passage_narrower_than_an_agent(
+        tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    # A wall across the level at x = 6 with a wide door at the top and a 0.4-wide slot
+    # near (6, 4.5): the level is one piece for a body, but the slot is too narrow for it.
+    wall = [[[5.8, 2], [6.2, 2], [6.2, 4.3], [5.8, 4.3]],
+            [[5.8, 4.7], [6.2, 4.7], [6.2, 8], [5.8, 8]]]
+    path = _write(tmp_path, "slot", wall)
+    code, err = _validate(capsys, str(path))
+    assert code == 0, err
+    assert "slot.json: warning: passage narrower than 0.6 units near (6.0, 4." in err
+    assert "ok" in err
+
+
+def test_validate_refuses_a_level_a_body_cannot_cross(
+        tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    wall = [[[5.8, 0], [6.2, 0], [6.2, 4.3], [5.8, 4.3]],
+            [[5.8, 4.7], [6.2, 4.7], [6.2, 8], [5.8, 8]]]  # the 0.4 slot is the only way
+    path = _write(tmp_path, "cut", wall)
+    code, err = _validate(capsys, str(path))
+    assert code == 2
+    assert "stealth: error: " in err and "cut.json" in err and "agent" in err
+    assert "Traceback" not in err
+
+
+def test_validate_is_quiet_on_the_bundled_levels(capsys: pytest.CaptureFixture[str]) -> None:
+    code, err = _validate(capsys, "miami", "maze")
+    assert code == 0 and "warning" not in err
+
+
+# ----------------------------------------------------------------------------- trials
+def _random_level(seed: int) -> Level:
+    """A 12 x 8 room with thin walls, pinch points (an obstacle touching the outline or
+    another at one point) and boxes; regenerated until it validates for a body."""
+    from navmesh.errors import LevelError
+
+    rng = np.random.default_rng(seed)
+    while True:
+        obstacles = []
+        for _ in range(rng.integers(2, 5)):  # thin walls, 0.05-0.2 thick, anywhere
+            x, y = rng.uniform(1, 11), rng.uniform(1, 7)
+            t, n = rng.uniform(0.05, 0.2), rng.uniform(1.5, 4)
+            if rng.random() < 0.5:
+                obstacles.append([[x, y], [x + t, y], [x + t, y + n], [x, y + n]])
+            else:
+                obstacles.append([[x, y], [x + n, y], [x + n, y + t], [x, y + t]])
+        for _ in range(rng.integers(1, 3)):  # diamonds touching the outline at a vertex
+            x, h, w = rng.uniform(2, 10), rng.uniform(1, 2.5), rng.uniform(0.3, 0.8)
+            top = bool(rng.random() < 0.5)
+            y0, s = (0.0, 1) if top else (8.0, -1)
+            obstacles.append([[x, y0], [x + w, y0 + s * h], [x, y0 + 2 * s * h],
+                              [x - w, y0 + s * h]])
+        for _ in range(rng.integers(0, 3)):  # boxes, some touching corner to corner
+            x, y, a = rng.uniform(1, 10), rng.uniform(1, 6), rng.uniform(0.5, 1.5)
+            obstacles.append([[x, y], [x + a, y], [x + a, y + a], [x, y + a]])
+            if rng.random() < 0.5:
+                obstacles.append([[x + a, y + a], [x + 2 * a, y + a], [x + 2 * a, y + 2 * a],
+                                  [x + a, y + 2 * a]])
+        try:
+            level = parse_level({
+                "format": "stealth-level/1", "name": f"random{seed}",
+                "outline": [[0, 0], [12, 0], [12, 8], [0, 8]], "obstacles": obstacles,
+                "guards": [[0.5, 0.5]] if shapely.intersects_xy(
+                    shapely.box(0, 0, 12, 8).difference(shapely.union_all(
+                        [shapely.Polygon(o) for o in obstacles])), 0.5, 0.5) else [[11.5, 7.5]],
+            })
+        except LevelError:
+            continue
+        body = level.walkable.buffer(-RADIUS, join_style="mitre")  # where a centre fits
+        if len([g for g in shapely.get_parts(body) if g.area > 1e-4]) == 1:
+            return level
+
+
+def _watch(level: Level, abstraction: str, guards: str, seed: int) -> tuple[float, float]:
+    """Run a 20-s fixed-time trial; the worst wall overlap and the longest unwanted stand."""
+    config = Config.load({"world.duration": 20.0})
+    world = World(level, abstraction, make_guard_ai(guards, config.section(guards)),
+                  make_player_policy("maxmin", player_params(config, "fixed")),
+                  config=config, scenario="fixed", seed=seed)
+    walls = level.walkable.boundary
+    agents = [*world.guards, world.player]
+    standing = [0.0] * len(agents)
+    last = [a.pos for a in agents]
+    overlap = longest = 0.0
+    while not world.done:
+        world.step()
+        pts = np.array([a.pos for a in agents])
+        gap = shapely.distance(walls, shapely.points(pts))
+        inside = shapely.intersects_xy(level.walkable, pts[:, 0], pts[:, 1])
+        overlap = max(overlap, float(np.where(inside, RADIUS - gap, RADIUS + gap).max()))
+        for k, agent in enumerate(agents):
+            stays = agent.target == agent.node and not agent.waypoints  # the controller's wish
+            standing[k] = standing[k] + world.dt if agent.pos == last[k] and not stays else 0.0
+            longest = max(longest, standing[k])
+        last = [a.pos for a in agents]
+    return overlap, longest
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_bodies_keep_off_walls_and_keep_moving_on_random_levels(seed: int) -> None:
+    level = _random_level(seed)
+    for abstraction in ("grid", "partition"):
+        for guards in ("pf", "random"):
+            overlap, longest = _watch(level, abstraction, guards, seed)
+            assert overlap <= TOL, f"{abstraction}/{guards}: a body {overlap:.3f} into a wall"
+            assert longest <= 3.0, f"{abstraction}/{guards}: an agent stood still {longest:.1f} s"
+
+
+def test_a_stuck_agent_replans_another_way() -> None:
+    # The agent is sent straight at a cell behind a thin wall (the blocked line). Once stuck
+    # it must take the way round the wall's end, not wait for its controller to re-decide
+    # the same line. (A second timeout hands it back to the controller, as before.)
+    level = _level([[[2.95, 0], [3.05, 0], [3.05, 2.4], [2.95, 2.4]]])
+    graph = graph_for(level, "grid")
+    walk = Locomotion(build_space(level), graph, level, RADIUS, 0.05)
+    start, goal = int(graph.cell_node[0, 2]), int(graph.cell_node[0, 3])
+    agent = walk.make_agent(start, 2.0)
+    agent.target, agent.waypoints = goal, deque([walk.node_point(goal)])
+    crossed = False
+    for _ in range(int(8 / 0.05)):
+        before = agent.pos
+        walk.drive(agent, agent.speed)
+        walk.space.step(0.05)
+        walk.settle(agent, before, agent.speed, 3.0)
+        agent.node = graph.node_near(*agent.pos, agent.node)
+        crossed = crossed or agent.pos[0] > 3.05 + RADIUS
+    assert crossed, f"still stuck at {agent.pos} (waypoints {list(agent.waypoints)})"
