@@ -42,7 +42,7 @@ def test_trace_lines_carry_awareness_role_and_phase_and_parse_back() -> None:
     assert line.guards[seer].awareness == record["guards"][seer]["awareness"]
 
 
-def test_the_meter_is_drawn_above_a_fully_aware_guard() -> None:
+def test_the_meter_is_drawn_below_a_fully_aware_guard() -> None:
     pygame.display.init()
     pygame.font.init()
     pygame.display.set_mode((960, 800))
@@ -62,8 +62,8 @@ def test_the_meter_is_drawn_above_a_fully_aware_guard() -> None:
             renderer.draw(surface, dataclasses.replace(scene, guards=guards), DrawOptions())
             images.append(pygame.surfarray.array3d(surface))
         x, y = renderer.to_screen(*scene.guards[i].pos)
-        radius = max(4.0, scene.agent_radius * renderer.layout.scale)
-        px, py = int(x), int(y - radius - 6)
+        radius = max(5.0, scene.agent_radius * renderer.layout.scale)
+        px, py = int(x), int(y + radius + 4)  # below: the state label sits above the guard
         assert tuple(images[0][px, py]) == pytest.approx(BAD, abs=2)
         assert not np.array_equal(images[0][px, py], images[1][px, py])
     finally:
