@@ -321,7 +321,10 @@ class NodeGraph:
             return self._dist[s], self._pred[s]
         dist, pred = self._rows.get(
             ("dist", s),
-            lambda: tuple(dijkstra(self.adjacency, directed=False, indices=s, return_predecessors=True)),
+            # symmetric adjacency: the directed search relaxes the same edges in the same
+            # order as the undirected one (same rows, same predecessors), without scipy
+            # transposing the matrix on every call
+            lambda: tuple(dijkstra(self.adjacency, indices=s, return_predecessors=True)),
         )
         return dist, pred
 
