@@ -169,7 +169,7 @@ def corpse(level: str, abstraction: str, seed: int) -> Measures:
             nonlocal removal
             if w.step_index % w.steps_per_tick:
                 return
-            track.append(float(w.graph.hops_between(active_guard_nodes(w), body).min()))
+            track.append(float(np.min(w.graph.hops_between(active_guard_nodes(w), body))))
             present = any(s.name == "corpse" for s in w.stimuli.active)
             if on and present:
                 found[0] = True

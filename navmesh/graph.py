@@ -76,7 +76,7 @@ class Neighbours(Sequence[np.ndarray]):
     def __len__(self) -> int:
         return len(self.indptr) - 1
 
-    def __getitem__(self, node):  # type: ignore[no-untyped-def,override]
+    def __getitem__(self, node):
         if isinstance(node, slice):
             return [self[i] for i in range(*node.indices(len(self)))]
         node = int(node)
@@ -89,7 +89,7 @@ class Neighbours(Sequence[np.ndarray]):
             yield self.indices[self.indptr[node] : self.indptr[node + 1]]
 
     @classmethod
-    def from_lists(cls, lists: Sequence[Sequence[int]]) -> Neighbours:
+    def from_lists(cls, lists: Sequence[Sequence[int]] | Sequence[np.ndarray]) -> Neighbours:
         """Pack per-node lists (kept in their given order)."""
         if isinstance(lists, Neighbours):
             return lists
@@ -288,7 +288,7 @@ class NodeGraph:
             return np.stack([self.hops_from(int(s), max_hops) for s in nodes]) if len(nodes) else (
                 np.zeros((0, self.n), dtype=np.int32)
             )
-        s = int(src)
+        s = int(np.asarray(src))
         if self.dense:
             row = self._hops[s]
             if max_hops is None:
@@ -342,7 +342,7 @@ class NodeGraph:
             if not len(nodes):
                 return np.zeros((0, self.n))
             return np.stack([self.dist_from(int(s), limit) for s in nodes])
-        s = int(src)
+        s = int(np.asarray(src))
         if limit is None:
             return self._dist_pred(s)[0]
         if self.dense:
