@@ -160,7 +160,7 @@ class CandidateSets(Sequence[np.ndarray]):
     def __len__(self) -> int:
         return self.graph.n
 
-    def __getitem__(self, node):  # type: ignore[no-untyped-def,unused-ignore]
+    def __getitem__(self, node):
         s = int(node)
         found = self._found.get(s)
         if found is None:

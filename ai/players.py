@@ -15,7 +15,7 @@ import numpy as np
 from scipy import sparse
 from scipy.sparse.csgraph import dijkstra
 
-from navmesh.graph import NodeGraph
+from navmesh.graph import Neighbours, NodeGraph
 
 from .fields import active_guard_nodes
 from .params import PlayerParams
@@ -55,12 +55,14 @@ class MoveSequences:
 
     def __init__(self, graph: NodeGraph, depth: int) -> None:
         self.depth = depth
-        width = max((len(nb) for nb in graph.neighbors), default=0) + 1
+        nb = Neighbours.from_lists(graph.neighbors)
+        count = np.diff(nb.indptr)
+        width = int(count.max(initial=0)) + 1
         #: (n, width) options per node: itself first, then its neighbours, padded with -1
         self.options = np.full((graph.n, width), -1, dtype=np.intp)
-        for node, nb in enumerate(graph.neighbors):
-            self.options[node, 0] = node
-            self.options[node, 1 : 1 + len(nb)] = nb
+        self.options[:, 0] = np.arange(graph.n)
+        owner = np.repeat(np.arange(graph.n), count)
+        self.options[owner, 1 + np.arange(len(nb.indices)) - nb.indptr[owner]] = nb.indices
         self._from: dict[int, np.ndarray] = {}
 
     def from_node(self, node: int) -> np.ndarray:

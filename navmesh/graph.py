@@ -78,7 +78,7 @@ class Neighbours(Sequence[np.ndarray]):
     def __len__(self) -> int:
         return len(self.indptr) - 1
 
-    def __getitem__(self, node):  # type: ignore[no-untyped-def,unused-ignore]
+    def __getitem__(self, node):
         if isinstance(node, slice):
             return [self[i] for i in range(*node.indices(len(self)))]
         node = int(node)
@@ -91,7 +91,7 @@ class Neighbours(Sequence[np.ndarray]):
             yield self.indices[self.indptr[node] : self.indptr[node + 1]]
 
     @classmethod
-    def from_lists(cls, lists: Sequence[Sequence[int]]) -> Neighbours:
+    def from_lists(cls, lists: Sequence[Sequence[int]] | Sequence[np.ndarray]) -> Neighbours:
         """Pack per-node lists (kept in their given order)."""
         if isinstance(lists, Neighbours):
             return lists
@@ -171,7 +171,7 @@ class NodeGraph:
     adjacency: csr_matrix = field(init=False, repr=False)
 
     def __post_init__(self) -> None:
-        self.neighbors = Neighbours.from_lists(self.neighbors)  # type: ignore[arg-type]
+        self.neighbors = Neighbours.from_lists(self.neighbors)
         n = len(self.positions)
         nb = self.neighbors
         rows = np.repeat(np.arange(n), np.diff(nb.indptr))
@@ -182,8 +182,6 @@ class NodeGraph:
             self.dense = n <= DENSE_MAX_NODES
         self._rows = RowCache(ROW_CACHE_BYTES)
         self._labels: np.ndarray | None = None
-        self._last_search: tuple[tuple[int, ...], float, np.ndarray] | None = None
-        self._last_bound: tuple[tuple[tuple[int, ...], int], float] | None = None
         if self.dense:
             hop_matrix = shortest_path(self.adjacency, method="D", unweighted=True)
             self._hops = _as_hops(hop_matrix)
@@ -303,7 +301,7 @@ class NodeGraph:
             return np.stack([self.hops_from(int(s), max_hops) for s in nodes]) if len(nodes) else (
                 np.zeros((0, self.n), dtype=np.int32)
             )
-        s = int(src)  # type: ignore[arg-type]
+        s = int(np.asarray(src))
         if self.dense:
             row = self._hops[s]
             if max_hops is None:
@@ -336,7 +334,10 @@ class NodeGraph:
             return self._dist[s], self._pred[s]
         dist, pred = self._rows.get(
             ("dist", s),
-            lambda: tuple(dijkstra(self.adjacency, directed=False, indices=s, return_predecessors=True)),
+            # symmetric adjacency: the directed search relaxes the same edges in the same
+            # order as the undirected one (same rows, same predecessors), without scipy
+            # transposing the matrix on every call
+            lambda: tuple(dijkstra(self.adjacency, indices=s, return_predecessors=True)),
         )
         return dist, pred
 
@@ -354,7 +355,7 @@ class NodeGraph:
             if not len(nodes):
                 return np.zeros((0, self.n))
             return np.stack([self.dist_from(int(s), limit) for s in nodes])
-        s = int(src)  # type: ignore[arg-type]
+        s = int(np.asarray(src))
         if limit is None:
             return self._dist_pred(s)[0]
         if self.dense:
@@ -390,9 +391,13 @@ class NodeGraph:
         rounded path sum from any source either way (a search stopped at a limit leaves the
         values inside it unchanged). ``inf`` with no source. With ``around``, only the nodes
         within metric distance ``reach`` of node ``around`` are promised (others may be
-        ``inf``): a large graph then searches no farther than the nearest source's distance
-        to ``around`` plus ``reach``.
+        ``inf``). A large graph answers every unlimited call with one search over the whole
+        graph per set of sources, cached: guards change nodes less often than the callers
+        ask (each physics step, each player move), so the row is shared by the distance
+        metric and the players until a guard moves (measured faster than a search bounded
+        at the nearest source, which needs a second search to find that bound).
         """
+        del around, reach  # a full row keeps every promise
         nodes = np.asarray(srcs, dtype=np.intp).ravel()
         if not len(nodes):
             return np.full(self.n, np.inf)
@@ -401,19 +406,6 @@ class NodeGraph:
             if limit is not None:
                 found = np.where(found <= limit, found, np.inf)
             return found
-        if around is not None and limit is None:
-            key = tuple(sorted(set(nodes.tolist())))
-            bound = self._reverse_bound(nodes, int(around), key)
-            if not np.isfinite(bound):
-                return np.full(self.n, np.inf)
-            needed = (bound + reach) * (1 + 1e-9) + 1e-9
-            last = self._last_search
-            if last is not None and last[0] == key and last[1] >= needed:
-                return last[2]  # a wider search from the same sources: same values inside
-            row = self._multi_source(nodes, needed)
-            row.flags.writeable = False
-            self._last_search = (key, needed, row)
-            return row
         if len(nodes) == 1 and limit is None:
             return self.dist_from(int(nodes[0]))
         nearest_key = ("nearest", tuple(sorted(set(nodes.tolist()))), limit)
@@ -426,41 +418,14 @@ class NodeGraph:
         return dijkstra(self.adjacency, indices=nodes, min_only=True,
                         limit=np.inf if limit is None else float(limit))
 
-    def _reverse_bound(self, nodes: np.ndarray, target: int, key: tuple[int, ...]) -> float:
-        """``min_s d(target, s)`` by a search from ``target`` grown until it meets a source.
-
-        Summed from the target's side, so it may differ from ``d(s, target)`` in the last
-        bit: callers use it only as a (padded) search limit. A straight line is a lower
-        bound on a path, so the first limit is already close.
-        """
-        if self._last_bound is not None and self._last_bound[0] == (key, target):
-            return self._last_bound[1]
-        bound = self._grow_reverse(nodes, target)
-        self._last_bound = ((key, target), bound)
-        return bound
-
-    def _grow_reverse(self, nodes: np.ndarray, target: int) -> float:
-        gap = float(np.linalg.norm(self.positions[nodes] - self.positions[target], axis=1).min())
-        limit = 1.25 * gap + 2.0 * self.max_edge_length
-        reached = -1
-        while True:
-            row = dijkstra(self.adjacency, indices=target, limit=limit)
-            found = row[nodes].min()
-            if np.isfinite(found):
-                return float(found)
-            count = int(np.isfinite(row).sum())
-            if count == reached:  # the search stopped growing: no source in this piece
-                return np.inf
-            reached, limit = count, 2.0 * limit
-
     def nearest_dist_to(self, srcs: Sequence[int] | np.ndarray, target: int) -> float:
-        """``min_s d(s, target)``: :meth:`nearest_dist` at one node, searching only as far as needed."""
+        """``min_s d(s, target)``: :meth:`nearest_dist` at one node."""
         nodes = np.asarray(srcs, dtype=np.intp).ravel()
         if not len(nodes):
             return np.inf
         if self.dense:
             return float(self._dist[nodes, target].min())
-        return float(self.nearest_dist(nodes, around=target)[target])
+        return float(self.nearest_dist(nodes)[target])
 
     def components(self) -> np.ndarray:
         """(n,) label of every node's connected piece."""
