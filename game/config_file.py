@@ -23,14 +23,15 @@ from typing import Any
 from game.config import Config
 from game.errors import ConfigError
 
-__all__ = ["read_config_file", "toml_value", "write_config_file"]
+__all__ = ["flatten", "read_config_file", "toml_value", "write_config_file"]
 
 
-def _flatten(table: Mapping[str, Any], prefix: str = "") -> dict[str, Any]:
+def flatten(table: Mapping[str, Any], prefix: str = "") -> dict[str, Any]:
+    """Nested TOML tables as dotted keys: ``{"pf": {"rho": 0.9}}`` -> ``{"pf.rho": 0.9}``."""
     flat: dict[str, Any] = {}
     for key, value in table.items():
         if isinstance(value, Mapping):
-            flat.update(_flatten(value, f"{prefix}{key}."))
+            flat.update(flatten(value, f"{prefix}{key}."))
         else:
             flat[f"{prefix}{key}"] = value
     return flat
@@ -47,7 +48,7 @@ def read_config_file(path: str | Path) -> dict[str, Any]:
         raise ConfigError(f"{where}: cannot read ({error})") from None
     except tomllib.TOMLDecodeError as error:
         raise ConfigError(f"{where}: not valid TOML ({error})") from None
-    flat = _flatten(data)
+    flat = flatten(data)
     try:
         config = Config.load(flat)
     except ConfigError as error:

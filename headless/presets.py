@@ -21,6 +21,7 @@ from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
+from game.config_file import flatten
 from game.trial import TrialSpec
 from navmesh.files import FileRefused, read_regular
 
@@ -183,16 +184,6 @@ def _fail(src: str, field: str, problem: str) -> PresetError:
     return PresetError(f"{src}: {field}: {' '.join(problem.splitlines())}")
 
 
-def _flatten(table: Mapping[str, Any], prefix: str = "") -> dict[str, Any]:
-    flat: dict[str, Any] = {}
-    for key, value in table.items():
-        if isinstance(value, Mapping):
-            flat.update(_flatten(value, f"{prefix}{key}."))
-        else:
-            flat[f"{prefix}{key}"] = value
-    return flat
-
-
 def check_setting(key: str, value: Any) -> Any:
     """A config value as the trials will run with it, or :class:`~game.errors.ConfigError`.
 
@@ -214,7 +205,7 @@ def _factors(data: Mapping[str, Any], src: str, fixed: Mapping[str, Any],
     if not isinstance(table, Mapping):
         raise _fail(src, "factors", "expected a table: config key = [values]")
     factors = []
-    for key, values in sorted(_flatten(table).items()):
+    for key, values in sorted(flatten(table).items()):
         where = f"factors.{key}"
         if key in fixed:
             raise _fail(src, where, "is also in [set]: a key is either fixed or a factor")
@@ -364,7 +355,7 @@ def parse_preset(
     overrides_table = data.get("set", {})
     if not isinstance(overrides_table, Mapping):
         raise _fail(src, "set", "expected a table of config overrides (dotted keys)")
-    flat = {**_flatten(overrides_table), **(extra or {})}
+    flat = {**flatten(overrides_table), **(extra or {})}
     try:
         config = Config.load(flat)
     except ConfigError as error:
