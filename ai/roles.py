@@ -142,7 +142,7 @@ def chokepoints(hops: HopTable, sighting: int, k: int, radius: int,
 
     >>> from navmesh.graph import NodeGraph
     >>> corridor = NodeGraph.from_grid(np.ones((1, 8), bool), 1.0)
-    >>> chokepoints(corridor.hops, 0, 1, 6)   # in a corridor the nearest ring node cuts most
+    >>> chokepoints(corridor.hops_from(np.arange(corridor.n)), 0, 1, 6)   # in a corridor the nearest ring node cuts most
     [(2, 4)]
     """
     if k <= 0:

@@ -51,7 +51,7 @@ def test_a_thin_wall_between_two_cell_centres_gives_no_edge() -> None:
     graph = graph_for(level, "grid")
     assert not _edge(graph, (0, 2), (0, 3))
     assert _edge(graph, (2, 2), (2, 3))  # below the wall the move is clear
-    assert np.isfinite(graph.dist).all()  # and the body-graph is still one piece
+    assert np.isfinite(graph.dist_from(0)).all()  # and the body-graph is still one piece
 
 
 def test_a_move_grazing_a_wall_closer_than_the_radius_gives_no_edge() -> None:

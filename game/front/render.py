@@ -488,8 +488,8 @@ def _clamp(value: float, lo: float, hi: float) -> float:
     return (lo + hi) / 2 if lo > hi else min(max(value, lo), hi)
 
 
-#: How long an idle frame loop blocks waiting for input (so it still redraws ~4 times/s).
-IDLE_WAIT_MS = 250
+#: How long an idle frame loop blocks waiting for input (so it still redraws twice a second).
+IDLE_WAIT_MS = 500
 
 
 class FrameLoop:
