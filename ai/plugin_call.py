@@ -29,7 +29,7 @@ import numpy as np
 from .errors import StimulusError
 
 if TYPE_CHECKING:
-    from .stimuli import Stimulus
+    from .stimulus import Stimulus
 
 __all__ = ["call", "checked_layer", "checked_number", "describe"]
 

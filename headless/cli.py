@@ -278,7 +278,7 @@ def _cmd_report(args: argparse.Namespace) -> int:
 
 
 def _cmd_mechanics(args: argparse.Namespace) -> int:
-    from .mechanics import cmd_mechanics
+    from .mechanics_run import cmd_mechanics
 
     return cmd_mechanics(args)
 

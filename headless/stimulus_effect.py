@@ -29,7 +29,8 @@ from game.world import SCENARIOS
 from navmesh.level import load_level
 
 from .errors import UserError
-from .mechanics import Row, effects_table, run_jobs, summarise, write_results
+from .mechanics import Row
+from .mechanics_run import effects_table, run_jobs, summarise, write_results
 
 __all__ = ["check_measure", "measure_label", "plugin_measures", "run_plugin_job",
            "cmd_stimulus_effect"]

@@ -128,9 +128,9 @@ def building_level(
     if form == "grid":
         data["grid"] = ["".join(".#"[int(not v)] for v in row) for row in walk]
     elif form == "polygon":
-        from .level import _cells_polygon
+        from .grid_geometry import cells_polygon
 
-        polygon = _cells_polygon(walk, 1.0)
+        polygon = cells_polygon(walk, 1.0)
         data["outline"] = [list(p) for p in polygon.exterior.coords[:-1]]
         data["obstacles"] = [[list(p) for p in ring.coords[:-1]] for ring in polygon.interiors]
     else:

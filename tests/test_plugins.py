@@ -227,7 +227,7 @@ def test_a_default_measure_has_no_intended_direction(tmp_path: Path, capsys) -> 
 
 
 def test_plugin_jobs_do_not_depend_on_the_worker_count() -> None:
-    from headless.mechanics import run_jobs
+    from headless.mechanics_run import run_jobs
     from headless.stimulus_effect import run_plugin_job
 
     jobs = [(PLUGIN, str(LEVEL), "grid", s) for s in range(2)]
