@@ -92,7 +92,7 @@ def level_stats(level: Any) -> dict[str, Any]:
 def cmd_levels(args: argparse.Namespace) -> int:
     from navmesh.level import bundled_level_names, load_level
 
-    from navmesh.graph import check_fits
+    from navmesh.sizing import check_fits
 
     names = args.level or bundled_level_names()
     levels = [load_level(name) for name in names]
@@ -118,7 +118,7 @@ def cmd_levels(args: argparse.Namespace) -> int:
 
 def cmd_validate(args: argparse.Namespace) -> int:
     from navmesh.errors import LevelError
-    from navmesh.graph import check_fits
+    from navmesh.sizing import check_fits
     from navmesh.level import load_level
 
     from ai.stimuli import load_stimulus

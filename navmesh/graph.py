@@ -505,12 +505,6 @@ def hop_ball_pairs(graph: NodeGraph, radius: int) -> tuple[np.ndarray, np.ndarra
     return coo.row.astype(np.intp), coo.col.astype(np.intp), hops
 
 
-def dense_bytes(n_nodes: int) -> int:
-    """Bytes of the dense all-pairs matrices of an n-node graph (int32 hops and predecessors,
-    float64 distances)."""
-    return 16 * n_nodes * n_nodes
-
-
 def build_graph(level: Level, abstraction: str,
                 radius: float = DEFAULT_AGENT_RADIUS) -> NodeGraph:
     """Build the node graph of ``level`` in ``abstraction`` ("grid" or "partition").
@@ -557,48 +551,3 @@ def graph_for(level: Level, abstraction: str,
     if level.digest is not None:
         return _cached_graph(_GraphKey(level.digest, abstraction, float(radius), level))
     return build_graph(level, abstraction, radius)
-
-
-#: Bytes a graph needs per node beyond dense matrices, measured with margin: CSR adjacency
-#: and neighbour lists, the radius-3 kernel, candidate sets, per-node world arrays.
-BYTES_PER_NODE = 4096
-
-
-def estimate_bytes(level: Level) -> tuple[int, int]:
-    """(nodes, bytes) a level needs to run, from its size alone, before building anything.
-
-    Nodes: the larger of the walkable cells and twice the walkable polygon's vertices (a
-    triangulation's triangle count). Bytes: per node, plus the dense matrices below
-    :data:`DENSE_MAX_NODES`, plus the bounded row caches.
-    """
-    cells = int(level.occupancy.sum())
-    vertices = len(level.walkable.exterior.coords) + sum(len(r.coords) for r in level.walkable.interiors)
-    nodes = max(cells, 2 * vertices)
-    dense = dense_bytes(nodes) if nodes <= DENSE_MAX_NODES else 0
-    return nodes, nodes * BYTES_PER_NODE + dense + 2 * ROW_CACHE_BYTES
-
-
-def available_bytes() -> int | None:
-    """Memory the machine can still give (``MemAvailable``), None where unknown."""
-    try:
-        with open("/proc/meminfo", encoding="ascii") as meminfo:
-            for line in meminfo:
-                if line.startswith("MemAvailable:"):
-                    return int(line.split()[1]) * 1024
-    except OSError:
-        return None
-    return None
-
-
-def check_fits(level: Level, source: str) -> None:
-    """Raise a one-line :class:`~navmesh.level.LevelError` if the level cannot run here."""
-    from .errors import LevelError
-
-    nodes, need = estimate_bytes(level)
-    have = available_bytes()
-    if have is not None and need > have:
-        raise LevelError(
-            source, "size",
-            f"{level.rows}x{level.cols} cells, about {nodes} nodes: needs about "
-            f"{need / 2**30:.1f} GB to run, {have / 2**30:.1f} GB available",
-        )

@@ -10,6 +10,7 @@ import numpy as np
 import pytest
 
 import navmesh.graph as graph_module
+import navmesh.sizing as sizing
 from game.trial import TrialSpec, run_trial
 from navmesh.buildings import building_level, building_occupancy
 from navmesh.graph import build_graph
@@ -63,10 +64,10 @@ def test_a_level_too_big_for_the_machine_is_refused_in_one_line(
     from navmesh.level import load_level
 
     level = load_level("maze")
-    graph_module.check_fits(level, "maze")  # fits
-    monkeypatch.setattr(graph_module, "available_bytes", lambda: 2**20)
+    sizing.check_fits(level, "maze")  # fits
+    monkeypatch.setattr(sizing, "available_bytes", lambda: 2**20)
     with pytest.raises(LevelError) as error:
-        graph_module.check_fits(level, "maze")
+        sizing.check_fits(level, "maze")
     message = str(error.value)
     assert message.startswith("maze: size: 20x20 cells, about ") and "nodes: needs about" in message
     assert "\n" not in message and "GB available" in message
