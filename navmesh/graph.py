@@ -20,7 +20,7 @@ from collections import OrderedDict
 from collections.abc import Callable, Hashable, Iterator, Sequence
 from dataclasses import dataclass, field
 from functools import lru_cache
-from typing import TYPE_CHECKING, Literal
+from typing import TYPE_CHECKING, Any, Literal
 
 import numpy as np
 from scipy.sparse import csr_matrix
@@ -318,15 +318,20 @@ class NodeGraph:
 
     def hops_between(self, a: int | np.ndarray | Sequence[int], b: int | np.ndarray | Sequence[int]) -> np.ndarray | int:
         """Hop distance of each pair (a[i], b[i]) (broadcast like numpy indexing)."""
+        found = self._pairwise(a, b, lambda: self._hops, self.hops_from, np.int32)
+        return int(found) if found.ndim == 0 else found
+
+    def _pairwise(self, a: Any, b: Any, dense: Callable[[], np.ndarray],
+                  row: Callable[[int], np.ndarray], dtype: type) -> np.ndarray:
+        """Each pair's value from the dense matrix, or from one per-source row per source."""
         if self.dense:
-            found = self._hops[a, b]
-            return int(found) if np.ndim(found) == 0 else found
+            return np.asarray(dense()[a, b])
         a_arr, b_arr = np.broadcast_arrays(np.asarray(a, dtype=np.intp), np.asarray(b, dtype=np.intp))
-        out = np.empty(a_arr.shape, dtype=np.int32)
+        out: np.ndarray = np.empty(a_arr.shape, dtype=dtype)
         for s in np.unique(a_arr):
             mask = a_arr == s
-            out[mask] = self.hops_from(int(s))[b_arr[mask]]
-        return int(out) if out.ndim == 0 else out
+            out[mask] = row(int(s))[b_arr[mask]]
+        return out
 
     # ------------------------------------------------------------------ metric distances
     def _dist_pred(self, s: int) -> tuple[np.ndarray, np.ndarray]:
@@ -368,15 +373,8 @@ class NodeGraph:
 
     def dist_between(self, a: int | np.ndarray | Sequence[int], b: int | np.ndarray | Sequence[int]) -> np.ndarray | float:
         """d(a[i], b[i]) of each pair (broadcast like numpy indexing), searched from a."""
-        if self.dense:
-            found = self._dist[a, b]
-            return float(found) if np.ndim(found) == 0 else found
-        a_arr, b_arr = np.broadcast_arrays(np.asarray(a, dtype=np.intp), np.asarray(b, dtype=np.intp))
-        out = np.empty(a_arr.shape, dtype=np.float64)
-        for s in np.unique(a_arr):
-            mask = a_arr == s
-            out[mask] = self.dist_from(int(s))[b_arr[mask]]
-        return float(out) if out.ndim == 0 else out
+        found = self._pairwise(a, b, lambda: self._dist, self.dist_from, np.float64)
+        return float(found) if found.ndim == 0 else found
 
     def nearest_dist(
         self,
