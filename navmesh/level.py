@@ -104,7 +104,7 @@ def _bundled_levels_dir() -> Path:
         return root / "assets" / "levels"
     try:
         return Path(str(importlib.resources.files("stealthfield_assets") / "levels"))
-    except ModuleNotFoundError:  # neither a checkout nor an install with the data package
+    except (ModuleNotFoundError, NotADirectoryError):  # no installed data package to read
         return root / "assets" / "levels"
 
 
