@@ -28,7 +28,7 @@ def stored_trial(directory: str | Path, key: str) -> StoredTrial:
     """The finished trial ``key`` of a results directory (one-line error when absent)."""
     path = Path(directory) / STORE_NAME
     if not path.is_file():
-        raise UserError(f"--from {directory}: no {STORE_NAME} here")
+        raise UserError(f"{directory}: no {STORE_NAME} here (a results directory of `stealth run`)")
     with ResultStore(path, readonly=True) as store:
         for trial in store.trials():
             if trial["key"] == key:

@@ -37,13 +37,14 @@ from typing import Any, Literal
 from game.config_file import read_config_file, write_config_file
 from game.errors import ConfigError
 from game.trial import TrialSpec
+from navmesh.files import FileRefused, read_regular
 
 from .errors import SweepError, UserError
 from .executors import (InlineExecutor, connect_dask, process_pool, run_batch, shutdown,
                         terminate)
 from .expr import Expression, parse_constraint, parse_expression
 from .objective import Target, as_trials, check_names, load_target, lookup_for
-from .presets import Preset, check_setting, parse_preset
+from .presets import MAX_PRESET_BYTES, Preset, check_setting, parse_preset
 
 __all__ = ["Param", "TuneSpec", "cmd_tune", "load_tune_spec", "run_study"]
 
@@ -152,10 +153,12 @@ def load_tune_spec(path: str | Path, extra: Mapping[str, Any] | None = None) -> 
         path = STUDIES_DIR / f"{path}.toml"  # a bundled study by name
     src = str(path)
     try:
-        text = path.read_text(encoding="utf-8")
+        text = read_regular(path, MAX_PRESET_BYTES).decode("utf-8")
         data = tomllib.loads(text)
     except FileNotFoundError:
         raise UserError(f"{src}: no such tune spec") from None
+    except FileRefused as error:
+        raise UserError(f"{src}: {error}") from None
     except (OSError, UnicodeDecodeError, tomllib.TOMLDecodeError) as error:
         raise UserError(f"{src}: cannot read ({' '.join(str(error).split())})") from None
     seeds_train = _count(data, "seeds_train", src, 1)

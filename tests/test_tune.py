@@ -126,3 +126,15 @@ def test_the_paper_table_is_a_target(tmp_path: Path) -> None:
     design = {"abstractions": ("grid",), "guards": ("pf",), "players": ("maxmin",),
               "scenarios": ("capture",)}
     assert len(load_target("paper-table3", tmp_path, design).cells) == 2
+
+
+def test_a_special_file_as_spec_is_refused_in_one_line(tmp_path: Path) -> None:
+    import os
+
+    from headless.tune import load_tune_spec
+    from navmesh.errors import StealthError
+
+    fifo = tmp_path / "spec.toml"
+    os.mkfifo(fifo)
+    with pytest.raises(StealthError, match="is a FIFO"):
+        load_tune_spec(fifo)  # refused at once, never blocks on the pipe
