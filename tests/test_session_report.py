@@ -82,3 +82,13 @@ def test_a_store_without_sessions_gets_no_session_files(tmp_path: Path) -> None:
              "player": "maxmin", "scenario": "capture", "seed": 0, "overrides": {}}
     assert write_session_report([trial], tmp_path) == []
     assert not (tmp_path / "sessions.md").exists()
+
+
+def test_replay_of_a_session_plays_its_recorded_trace(store: Path, monkeypatch: pytest.MonkeyPatch,
+                                                      capsys: pytest.CaptureFixture[str]) -> None:
+    from headless.cli import main
+
+    monkeypatch.setenv("SDL_VIDEODRIVER", "dummy")
+    key = next(r["key"] for r in _csv(store / "trials.csv") if r["player"] == HUMAN)
+    assert main(["replay", str(store), "--trial", key, "--frames", "5"]) == 0
+    assert "5 frames" in capsys.readouterr().err
