@@ -198,12 +198,18 @@ class Renderer:
             self.resize(surface.get_size())
         self._wrap_help(options.help)
         area = self.layout.world_rect
-        surface.fill(BACKGROUND)
         static, region = self.layers.surface(self.visible(), self.layout.scale, scene.layer,
                                              options.show_mesh)
         sx, sy = self.to_screen(region.x0, region.y0)
+        placed = static.get_rect(topleft=(round(sx), round(sy)))
+        if placed.contains(area):  # the map is covered: clear only the HUD and help bands
+            surface.fill(BACKGROUND, (0, 0, surface.get_width(), area.top))
+            surface.fill(BACKGROUND, (0, area.bottom, surface.get_width(),
+                                      surface.get_height() - area.bottom))
+        else:
+            surface.fill(BACKGROUND)
         surface.set_clip(area)
-        surface.blit(static, (round(sx), round(sy)))
+        surface.blit(static, placed)
         s = self.layout.scale
         for x, y in scene.markers:
             self._diamond(surface, self.to_screen(x, y), max(6, s * 0.35), MARKER, 0)
