@@ -68,6 +68,8 @@ class PotentialFieldGuards(GuardAI):
         self.graph, self.rng, self.n_guards = graph, rng, n_guards
         self.field = CompositeField(graph, self.config)
         self._last: list[_Decision | None] = [None] * n_guards
+        #: explain(i)'s answer for the decision it was made from (same dict until the next)
+        self._explained: dict[int, tuple[_Decision, dict[str, Any]]] = {}
         #: each guard's last 5 decided nodes (the window the backtrack metric uses)
         self._recent: list[deque[int]] = [deque(maxlen=5) for _ in range(n_guards)]
         #: per guard, its own field term and why (coordinated roles), else None
@@ -165,6 +167,9 @@ class PotentialFieldGuards(GuardAI):
         record = self._last[i] if 0 <= i < len(self._last) else None
         if record is None:
             return None
+        cached = self._explained.get(i)
+        if cached is not None and cached[0] is record:  # a pure function of the decision:
+            return cached[1]  # the game asks every frame, the decision changes about 1/s
         w_I, w_C, w_N = record.weights  # noqa: N806 — the paper's symbols
         connectivity = self.field.connectivity
         live = self.field.teammate_confidence(record.teammates)
@@ -187,7 +192,7 @@ class PotentialFieldGuards(GuardAI):
             for entry, c in zip(candidates, record.choice.candidates, strict=True):
                 entry["role_term"] = float(record.personal[c])
         role = {"role": record.role} if record.role is not None else {}
-        return {
+        answer = {
             **role,
             "mode": self.mode,
             "guard": int(i),
@@ -201,6 +206,8 @@ class PotentialFieldGuards(GuardAI):
             "tied": [int(c) for c in record.choice.tied],
             "tie_broken": bool(len(record.choice.tied) > 1),
         }
+        self._explained[i] = (record, answer)
+        return answer
 
     def fields(self) -> dict[str, np.ndarray]:
         """Current I, I_extra, C, N, P, K arrays (read-only), for the game overlay."""

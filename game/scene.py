@@ -26,6 +26,7 @@ with matplotlib could be another.
 
 from __future__ import annotations
 
+import functools
 import math
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
@@ -457,28 +458,42 @@ class _WallBuckets:
     def __init__(self, walls: np.ndarray, corners: np.ndarray) -> None:
         lo = np.floor(walls.min(axis=1) / _BUCKET_SIZE).astype(np.int64)
         hi = np.floor(walls.max(axis=1) / _BUCKET_SIZE).astype(np.int64)
-        self.walls: dict[tuple[int, int], list[int]] = {}
+        lists: dict[tuple[int, int], list[int]] = {}
         for i, ((x0, y0), (x1, y1)) in enumerate(zip(lo.tolist(), hi.tolist())):
             for bx in range(x0, x1 + 1):
                 for by in range(y0, y1 + 1):
-                    self.walls.setdefault((bx, by), []).append(i)
-        self.corners: dict[tuple[int, int], list[int]] = {}
+                    lists.setdefault((bx, by), []).append(i)
+        self.walls = {k: np.asarray(v, dtype=np.int64) for k, v in lists.items()}
         cells = np.floor(corners / _BUCKET_SIZE).astype(np.int64)
+        lists = {}
         for i, (bx, by) in enumerate(cells.tolist()):
-            self.corners.setdefault((bx, by), []).append(i)
+            lists.setdefault((bx, by), []).append(i)
+        self.corners = {k: np.asarray(v, dtype=np.int64) for k, v in lists.items()}
+        self._none = np.zeros(0, dtype=np.int64)
 
     def near(self, pos: Sequence[float], reach: float) -> tuple[np.ndarray, np.ndarray]:
-        """Indices of the walls and corners in the buckets a disc of ``reach`` touches."""
+        """Indices (sorted, each once) of the walls and corners in the buckets a disc of
+        ``reach`` touches."""
         x0, y0 = (math.floor((float(v) - reach) / _BUCKET_SIZE) for v in pos)
         x1, y1 = (math.floor((float(v) + reach) / _BUCKET_SIZE) for v in pos)
-        walls: set[int] = set()
-        corners: list[int] = []
-        for bx in range(x0, x1 + 1):
-            for by in range(y0, y1 + 1):
-                walls.update(self.walls.get((bx, by), ()))
-                corners += self.corners.get((bx, by), [])
-        return (np.fromiter(sorted(walls), dtype=np.int64, count=len(walls)),
-                np.asarray(sorted(corners), dtype=np.int64))
+        keys = [(bx, by) for bx in range(x0, x1 + 1) for by in range(y0, y1 + 1)]
+        walls = [self.walls[k] for k in keys if k in self.walls]
+        corners = [self.corners[k] for k in keys if k in self.corners]
+        # a wall spanning two buckets is listed in both: unique; a corner is in one bucket
+        return (np.unique(np.concatenate(walls)) if walls else self._none,
+                np.sort(np.concatenate(corners)) if corners else self._none)
+
+
+#: Below this many candidate walls a cone tests them all rather than filtering by distance.
+_NEAR_FILTER_MIN = 96
+
+
+@functools.lru_cache(maxsize=16)
+def _ray_offsets(half_fov: float, rays: int) -> np.ndarray:
+    """The evenly spaced ray angles relative to the heading (the same for every cone)."""
+    offsets = np.linspace(-half_fov, half_fov, rays)
+    offsets.flags.writeable = False
+    return offsets
 
 
 def vision_cone(
@@ -494,14 +509,17 @@ def vision_cone(
     """
     px, py = float(pos[0]), float(pos[1])
     origin = np.array([px, py])
-    # Walls that can matter: closest point within reach.
-    rel = origin - wall_start
-    dd = np.einsum("ij,ij->i", wall_delta, wall_delta)
-    s = np.clip(np.einsum("ij,ij->i", rel, wall_delta) / np.maximum(dd, 1e-18), 0.0, 1.0)
-    near = np.hypot(*(wall_start + s[:, None] * wall_delta - origin).T) <= reach + 1e-9
-    a, d = wall_start[near], wall_delta[near]
+    a, d = wall_start, wall_delta
+    if len(a) > _NEAR_FILTER_MIN:
+        # Walls that can matter: closest point within reach (a wall farther away cannot
+        # stop a ray before ``reach``, so with few walls testing them all is cheaper).
+        rel = origin - wall_start
+        dd = np.einsum("ij,ij->i", wall_delta, wall_delta)
+        s = np.clip(np.einsum("ij,ij->i", rel, wall_delta) / np.maximum(dd, 1e-18), 0.0, 1.0)
+        near = np.hypot(*(wall_start + s[:, None] * wall_delta - origin).T) <= reach + 1e-9
+        a, d = wall_start[near], wall_delta[near]
 
-    angles = heading + np.linspace(-half_fov, half_fov, rays)
+    angles = heading + _ray_offsets(half_fov, rays)
     if len(corners):
         cv = corners - origin
         cd = np.hypot(cv[:, 0], cv[:, 1])

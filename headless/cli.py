@@ -303,8 +303,12 @@ def _cmd_replay(args: argparse.Namespace) -> int:
     from game.front.replay import cmd_replay, replay_trial
 
     if args.trial is not None:
-        from .reproduce import stored_spec
+        from .reproduce import stored_spec, stored_trial
+        from .sessions import session_trace
 
+        if stored_trial(args.trace, args.trial)["player"] == "human":  # a played session:
+            args.trace = str(session_trace(args.trace, args.trial))  # its recorded trace
+            return cmd_replay(args)
         return replay_trial(stored_spec(args.trace, args.trial), args)
     return cmd_replay(args)
 

@@ -69,6 +69,10 @@ def readme(directory: Path, meta: Mapping[str, str], done: int, skipped_heat: in
                      "more); light grey = no events. |")
     lines.append("| | Each guard mode has one colour in every figure (PotentialField blue, "
                  "RandomWalk orange, FSM green, Staleness red, Cheat purple). |")
+    if "sessions.md" in names:
+        lines.append("| `sessions.md`, `sessions.csv` | recorded play sessions (`player = human`): "
+                     "outcome, stars, ratings, and human against the policies on the same "
+                     "seeds |")
     if failed:
         lines.append("| `failed.csv` | trials that raised: identity and the error text |")
     lines += [

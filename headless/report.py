@@ -14,6 +14,8 @@ Everything is written into DIR next to ``results.sqlite``:
   with the paper's values overlaid when the design is the paper's;
 * ``factors.{md,csv}``, ``factors/*/table.md``, ``factor_*.png`` — only for a design with
   factors (:mod:`headless.factor_report`);
+* ``sessions.md`` / ``sessions.csv`` — only for recorded play sessions
+  (:mod:`headless.session_report`);
 * ``failed.csv`` — only when some trial failed;
 * ``README.md`` — what the files are and where our metrics differ from the paper's.
 
@@ -41,6 +43,7 @@ from .heatmaps import HeatSums, figure_count, write_heatmaps
 from .paper import is_paper_design, paper_table3
 from .progress import Progress
 from .readme import readme
+from .session_report import write_session_report
 from .stats import BOOTSTRAP_RESAMPLES, BOOTSTRAP_SEED, Stat, bootstrap_ci, summarise
 from .store import IDENTITY, STORE_NAME, ResultStore
 from .tables import metric_value, table_columns, table_rows, write_table, write_trials_csv
@@ -112,6 +115,7 @@ def write_report(directory: str | Path, *, figures: bool = True,
 
     written += write_factor_report(trials, directory, design.get("abstractions"),
                                    figures=figures)
+    written += write_session_report(trials, directory)
     abstractions = len(dict.fromkeys(r["abstraction"] for r in rows))
     bar = Progress(figure_count(heat) + abstractions, sys.stderr,
                    enabled=progress and figures, unit="figures")

@@ -22,10 +22,17 @@ from game.trial import TrialSpec
 from .errors import UserError
 from .store import STORE_NAME, ResultStore
 
-__all__ = ["COMPARE", "SessionStore"]
+__all__ = ["COMPARE", "SessionStore", "session_trace"]
 
 #: The player policies every recorded session is compared with.
 COMPARE: tuple[str, ...] = ("maxmin", "safetygraph")
+
+
+def session_trace(directory: str | Path, key: str) -> Path:
+    """Where the trace of session ``key`` is kept: ``DIR/sessions/<key as a file name>.jsonl``
+    (``stealth replay DIR --trial KEY`` plays it: a human session cannot be re-simulated)."""
+    name = re.sub(r"[^A-Za-z0-9_.=-]+", "_", key)
+    return Path(directory) / "sessions" / f"{name}.jsonl"
 
 
 class SessionStore:
@@ -43,8 +50,7 @@ class SessionStore:
 
     def __call__(self, row: Mapping[str, Any], trace: Sequence[str]) -> None:
         """Store one session row, its trace, and the comparison policies' trials."""
-        name = re.sub(r"[^A-Za-z0-9_.=-]+", "_", str(row["key"]))
-        (self.directory / "sessions" / f"{name}.jsonl").write_text(
+        session_trace(self.directory, str(row["key"])).write_text(
             "".join(line + "\n" for line in trace), encoding="utf-8")
         with ResultStore(self.directory / STORE_NAME) as store:
             store.add(row)

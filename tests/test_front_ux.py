@@ -167,3 +167,38 @@ def test_screenshot_command_makes_exactly_the_images_docs_show() -> None:
     shown = set(re.findall(r"\(img/(play-[^)]+\.png|replay-[^)]+\.png)\)",
                            (ROOT / "docs" / "play.md").read_text()))
     assert shown == set(SHOTS)
+
+
+def test_replay_has_the_camera_and_minimap_of_the_game(tmp_path: Path) -> None:
+    """A trace on a level too large for the window replays zoomed in, following the player;
+    wheel and + / - zoom as in the game (Up / Down keep the speed)."""
+    import io
+
+    from game.front.replay import ReplayViewer
+    from game.trace import load_trace
+    from game.trial import run_trial
+    from navmesh.level import load_level
+
+    path = tmp_path / "building.json"
+    path.write_text(json.dumps(building_level(120, 160, room=12, guards=4)))
+    trace = io.StringIO()
+    run_trial(TrialSpec(str(path), "grid", "pf", "maxmin", "capture", seed=0,
+                        overrides=(("world.duration", 6.0),)), trace=trace)
+    (tmp_path / "run.jsonl").write_text(trace.getvalue())
+    viewer = ReplayViewer(load_trace(str(tmp_path / "run.jsonl")), load_level(str(path)), "grid",
+                          speed=4.0, size=(960, 800))
+    assert viewer.camera.zoom is not None and viewer.renderer.zoomed  # starts zoomed in
+    viewer.run(40)
+    area = viewer.renderer.layout.world_rect
+    assert area.collidepoint(*viewer.renderer.to_screen(*viewer.focus()))
+    before = viewer.camera.zoom
+    pygame.event.post(pygame.event.Event(pygame.MOUSEWHEEL, x=0, y=1))
+    viewer.run(1)
+    assert viewer.camera.zoom > before
+    for _ in range(12):
+        pygame.event.post(pygame.event.Event(pygame.KEYDOWN, key=pygame.K_MINUS, mod=0, unicode="-"))
+    viewer.run(1)
+    assert viewer.camera.zoom is None and not viewer.renderer.zoomed  # the whole level again
+    pygame.event.post(pygame.event.Event(pygame.KEYDOWN, key=pygame.K_UP, mod=0, unicode=""))
+    viewer.run(1)
+    assert viewer.speed == 8.0

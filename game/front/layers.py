@@ -20,6 +20,7 @@ from dataclasses import dataclass
 
 import numpy as np
 import pygame
+import shapely
 
 from game.scene import FieldLayer, StaticScene
 
@@ -71,6 +72,11 @@ def _meets(boxes: np.ndarray, region: Region) -> np.ndarray:
             & (boxes[:, 3] >= region.y0) & (boxes[:, 1] <= region.y1))
 
 
+def _meeting(boxes: np.ndarray, region: Region) -> np.ndarray:
+    """Indices of the boxes that meet ``region`` (the loops draw only those)."""
+    return np.flatnonzero(_meets(boxes, region))
+
+
 class StaticLayers:
     """The static layer of one :class:`StaticScene`, cached by region, field and options."""
 
@@ -96,6 +102,8 @@ class StaticLayers:
         self._composite: pygame.Surface | None = None
         self._composite_key: tuple[object, bool] | None = None
         self._layer: FieldLayer | None = None
+        self._pool: dict[str, pygame.Surface] = {}
+        self._outline_shape = shapely.Polygon(outline) if len(outline) >= 3 else None
         self.rebuilds = 0
 
     # ------------------------------------------------------------------ public
@@ -132,9 +140,7 @@ class StaticLayers:
 
     def _compose(self, layer: FieldLayer | None, show_mesh: bool) -> None:
         base = self._base_surface()
-        surface = self._composite
-        if surface is None or surface.get_size() != base.get_size():
-            surface = pygame.Surface(base.get_size()).convert()
+        surface = self._blank("composite")
         surface.blit(base, (0, 0))
         if layer is not None:
             self._draw_field(surface, layer.norm)
@@ -147,9 +153,32 @@ class StaticLayers:
         surface.blit(self._lines, (0, 0))
         self._composite = surface
 
-    def _keyed(self, draw: Callable[[pygame.Surface], None]) -> pygame.Surface:
+    def _blank(self, role: str) -> pygame.Surface:
+        """The surface of one role (base, composite, line layers) at the region's size,
+        reused from the last region when the size is the same (no allocation per rebuild)."""
         assert self.region is not None
-        surface = pygame.Surface(self.region.size).convert()
+        surface = self._pool.get(role)
+        if surface is None or surface.get_size() != self.region.size:
+            surface = self._pool[role] = pygame.Surface(self.region.size).convert()
+        return surface
+
+    def _floor_outline(self, region: Region) -> list[np.ndarray]:
+        """The floor's outer ring, clipped to the region when it reaches beyond it (a large
+        level's outline is filled over a region-sized surface only, not the whole level)."""
+        outline = self._outline
+        if self._outline_shape is None or (
+                outline[:, 0].min() >= region.x0 and outline[:, 1].min() >= region.y0
+                and outline[:, 0].max() <= region.x1 and outline[:, 1].max() <= region.y1):
+            return [outline]
+        pad = 1.0 / region.scale  # a pixel beyond the region, so no edge shows at its border
+        clipped = shapely.clip_by_rect(self._outline_shape, region.x0 - pad, region.y0 - pad,
+                                       region.x1 + pad, region.y1 + pad)
+        return [np.asarray(p.exterior.coords) for p in shapely.get_parts(clipped)
+                if isinstance(p, shapely.Polygon) and not p.is_empty]
+
+    def _keyed(self, draw: Callable[[pygame.Surface], None]) -> pygame.Surface:
+        surface = self._blank(draw.__name__)
+        surface.set_colorkey(None)
         surface.fill(_KEY)
         draw(surface)
         surface.set_colorkey(_KEY, pygame.RLEACCEL)
@@ -160,18 +189,19 @@ class StaticLayers:
             return self._base
         region = self.region
         assert region is not None
-        surface = pygame.Surface(region.size).convert()
+        surface = self._blank("base")
         surface.fill(BACKGROUND)
         extent = self._pts(np.array([[0.0, 0.0], [self.static.width, self.static.height]]))
         (ax, ay), (bx, by) = extent
         surface.fill(BLOCKED, pygame.Rect(round(ax), round(ay), round(bx - ax), round(by - ay)))
-        pygame.draw.polygon(surface, FLOOR, self._pts(self._outline))
-        holes = [h for h, ok in zip(self._holes, _meets(self._hole_boxes, region)) if ok]
+        for ring in self._floor_outline(region):
+            pygame.draw.polygon(surface, FLOOR, self._pts(ring))
+        holes = [self._holes[i] for i in _meeting(self._hole_boxes, region)]
         for hole in holes:
             pygame.draw.polygon(surface, BLOCKED, self._pts(hole))
-        for (kind, ring), ok in zip(self._zones, _meets(self._zone_boxes, region)):
-            if ok:
-                pygame.draw.polygon(surface, ZONE_FILL.get(kind, FLOOR), self._pts(ring))
+        for i in _meeting(self._zone_boxes, region):
+            kind, ring = self._zones[i]
+            pygame.draw.polygon(surface, ZONE_FILL.get(kind, FLOOR), self._pts(ring))
         for hole in holes:  # a zone clipped to the floor has the obstacles as its holes
             pygame.draw.polygon(surface, BLOCKED, self._pts(hole))
         self._base = surface
@@ -182,20 +212,19 @@ class StaticLayers:
         region = self.region
         assert region is not None
         s = region.scale
-        for (kind, ring), ok in zip(self._zones, _meets(self._zone_boxes, region)):
-            if ok:
-                pts = self._pts(ring)
-                pygame.draw.lines(surface, HALO, True, pts, 4)
-                pygame.draw.lines(surface, ZONE_EDGE.get(kind, TEXT_DIM), True, pts, 2)
+        for i in _meeting(self._zone_boxes, region):
+            kind, ring = self._zones[i]
+            pts = self._pts(ring)
+            pygame.draw.lines(surface, HALO, True, pts, 4)
+            pygame.draw.lines(surface, ZONE_EDGE.get(kind, TEXT_DIM), True, pts, 2)
         for ring in self._exits:
             pts = self._pts(ring)
             pygame.draw.lines(surface, HALO, True, pts, 6)
             pygame.draw.lines(surface, EXIT_EDGE, True, pts, 3)
         width = max(2, round(s * 0.12))
-        for (a, b), ok in zip(self._walls, _meets(self._wall_boxes, region)):
-            if ok:
-                pa, pb = self._pts(np.array([a, b]))
-                pygame.draw.line(surface, (236, 236, 244), pa, pb, width)
+        walls = (self._walls[_meeting(self._wall_boxes, region)] - (region.x0, region.y0)) * s
+        for pa, pb in walls.tolist():
+            pygame.draw.line(surface, (236, 236, 244), pa, pb, width)
         for x, y in self.static.decoys:
             (cx, cy), = self._pts(np.array([[x, y]]))
             r = max(5.0, s * 0.3)
@@ -214,9 +243,9 @@ class StaticLayers:
         region = self.region
         assert region is not None
         if self._tris is not None:
-            for tri, ok in zip(self._tris, _meets(self._tri_boxes, region)):
-                if ok:
-                    pygame.draw.lines(surface, MESH, True, self._pts(tri), 1)
+            for tri in ((self._tris[_meeting(self._tri_boxes, region)] - (region.x0, region.y0))
+                        * region.scale).tolist():
+                pygame.draw.lines(surface, MESH, True, tri, 1)
             return
         cell = self.static.cell_size * region.scale
         if cell < MIN_CELL_PIXELS:
@@ -251,7 +280,8 @@ class StaticLayers:
             surface.blit(big, (round(x), round(y)))
         elif self._tris is not None:
             layer = pygame.Surface(surface.get_size(), pygame.SRCALPHA).convert_alpha()
-            for tri, ok, (r, g, b) in zip(self._tris, _meets(self._tri_boxes, region), rgb.tolist()):
-                if ok:
-                    pygame.draw.polygon(layer, (r, g, b, OVERLAY_ALPHA), self._pts(tri))
+            shown = _meeting(self._tri_boxes, region)
+            tris = ((self._tris[shown] - (region.x0, region.y0)) * region.scale).tolist()
+            for tri, (r, g, b) in zip(tris, rgb[shown].tolist()):
+                pygame.draw.polygon(layer, (r, g, b, OVERLAY_ALPHA), tri)
             surface.blit(layer, (0, 0))

@@ -23,7 +23,7 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from typing import Any
 
-from game.front.camera import ZOOM_STEP, Camera
+from game.front.camera import Camera
 from game.front.effects import NoiseRings, draw_rain
 from game.front.palette import BAD, GOOD, WARN
 from game.front.render import (
@@ -272,16 +272,10 @@ class PlayGame(FrameLoop):
             static = self.builder.static
             if 0 <= x <= static.width and 0 <= y <= static.height:
                 self._mechanic("throw_decoy", x, y)
-        elif event.type == pygame.MOUSEWHEEL and event.y:
-            self.zoom(ZOOM_STEP if event.y > 0 else 1 / ZOOM_STEP)
+        elif (factor := self.zoom_input(event)) is not None:
+            self.zoom(factor)
         elif event.type == pygame.KEYDOWN:
             self._key(event.key)
-
-    def zoom(self, factor: float) -> None:
-        """Zoom the camera in (factor > 1) or out, around the player."""
-        self.camera.follow(self.world.player.pos)
-        self.camera.zoom_by(factor, self.renderer.fit_scale())
-        self.renderer.refresh_view()
 
     def _key(self, key: int) -> None:
         if self.state == "questions":
@@ -298,10 +292,6 @@ class PlayGame(FrameLoop):
             self.show_mesh = not self.show_mesh
         elif key == pygame.K_g:
             self.show_plans = not self.show_plans
-        elif key in (pygame.K_EQUALS, pygame.K_PLUS, pygame.K_KP_PLUS):
-            self.zoom(ZOOM_STEP)
-        elif key in (pygame.K_MINUS, pygame.K_KP_MINUS):
-            self.zoom(1 / ZOOM_STEP)
         elif key in (pygame.K_RETURN, pygame.K_KP_ENTER):
             self.restart()
         elif key == pygame.K_n:
@@ -351,6 +341,10 @@ class PlayGame(FrameLoop):
         self.world.sprinting = bool(mods & pygame.KMOD_SHIFT)
 
     # ------------------------------------------------------------------ frames
+    def focus(self) -> tuple[float, float]:
+        """The camera follows the player."""
+        return self.world.player.pos
+
     def idle(self) -> bool:
         """Paused, on the ready screen or after the game: nothing moves without a key."""
         return self.paused or self.state != "playing"
@@ -447,9 +441,7 @@ class PlayGame(FrameLoop):
     def draw(self) -> Scene:
         """Build the scene of the world now and draw it to the window."""
         scene = self.builder.from_world(self.world, self.overlay, plans=self.show_plans)
-        if self.camera.zoom is not None:
-            self.camera.follow(self.world.player.pos)
-            self.renderer.refresh_view()
+        self.follow()
         self.renderer.draw(self.screen, scene, self.options())
         self.scene = scene
         return scene

@@ -23,6 +23,7 @@ from pathlib import Path
 import numpy as np
 
 from game.agents import max_agent_speed
+from game.front.camera import Camera
 from game.front.render import DrawOptions, FrameLoop, Renderer, default_window_size, init_pygame, pygame
 from game.scene import GuardDrawing, PlayerDrawing, Scene, SceneBuilder
 from game.trace import GuardRecord, Trace, TraceError, TraceLine, load_trace, parse_line
@@ -211,12 +212,14 @@ class ReplayViewer(FrameLoop):
         size = size or default_window_size(self.builder.static)
         pygame.display.set_caption(f"Stealthfield replay — {Path(trace.path).name}")
         self.screen = pygame.display.set_mode(size, pygame.RESIZABLE)
-        self.renderer = Renderer(self.builder.static, self.screen.get_size())
+        self.camera = Camera()  # the same camera and minimap as the game (large levels)
+        self.renderer = Renderer(self.builder.static, self.screen.get_size(), self.camera)
         self.clock = pygame.time.Clock()
+        self._player = self.playback.state(self.t)[2]
 
     # ------------------------------------------------------------------ input
-    HELP = ("Space pause", "Right/Left step one tick", "Up/Down speed", "Home restart",
-            "M mesh/grid", "G targets", "Esc quit")
+    HELP = ("Space pause", "Right/Left step one tick", "Up/Down speed", "wheel/+ - zoom",
+            "Home restart", "M mesh/grid", "G targets", "Esc quit")
 
     def _step_line(self, direction: int) -> None:
         self.paused = True
@@ -232,7 +235,9 @@ class ReplayViewer(FrameLoop):
         """React to one pygame event."""
         if self.handle_window(event):
             return
-        if event.type == pygame.KEYDOWN:
+        if (factor := self.zoom_input(event)) is not None:
+            self.zoom(factor)
+        elif event.type == pygame.KEYDOWN:
             key = event.key
             if key == pygame.K_ESCAPE:
                 self.running = False
@@ -242,9 +247,9 @@ class ReplayViewer(FrameLoop):
                 self._step_line(+1)
             elif key in (pygame.K_LEFT, pygame.K_COMMA):
                 self._step_line(-1)
-            elif key in (pygame.K_UP, pygame.K_PLUS, pygame.K_EQUALS, pygame.K_KP_PLUS):
+            elif key == pygame.K_UP:
                 self._speed(+1)
-            elif key in (pygame.K_DOWN, pygame.K_MINUS, pygame.K_KP_MINUS):
+            elif key == pygame.K_DOWN:
                 self._speed(-1)
             elif key in (pygame.K_HOME, pygame.K_BACKSPACE):
                 self.t, self.paused = self.playback.start, False
@@ -254,9 +259,14 @@ class ReplayViewer(FrameLoop):
                 self.show_plans = not self.show_plans
 
     # ------------------------------------------------------------------ frames
+    def focus(self) -> tuple[float, float]:
+        """The camera follows the replayed player."""
+        return self._player
+
     def scene(self) -> Scene:
         """The picture of the trace at the current playback time."""
         line, guards, ppos, pheading, hp = self.playback.state(self.t)
+        self._player = ppos
         node = self.graph.node_at(*ppos)
         concealed = bool(self.concealment[node])
         reach = self.view_range * float(self.view_scale[node])
@@ -304,6 +314,7 @@ class ReplayViewer(FrameLoop):
             help=self.HELP, info=info, legend=False,
             banner="END OF TRACE" if ended else None, banner_sub="Home restart · Left step back · Esc quit",
         )
+        self.follow()
         self.renderer.draw(self.screen, scene, options)
         pygame.display.flip()
 

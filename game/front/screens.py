@@ -33,6 +33,8 @@ class Panel:
 
 
 _FONTS: dict[int, pygame.font.Font] = {}
+#: Rendered lines by (font size, text, colour): a panel shown for many frames renders once.
+_TEXTS: dict[tuple[int, str, Color], pygame.Surface] = {}
 
 
 def _font(size: int) -> pygame.font.Font:
@@ -42,22 +44,31 @@ def _font(size: int) -> pygame.font.Font:
     return font
 
 
+def _render(size: int, text: str, color: Color) -> pygame.Surface:
+    key = (size, text, color)
+    label = _TEXTS.get(key)
+    if label is None:
+        if len(_TEXTS) > 256:
+            _TEXTS.clear()
+        label = _TEXTS[key] = _font(size).render(text, True, color)
+    return label
+
+
 def draw_panel(surface: pygame.Surface, area: pygame.Rect, panel: Panel,
                avoid: tuple[float, float] | None = None) -> pygame.Rect:
     """Draw ``panel`` inside the map ``area``; returns the box drawn.
 
     A wide panel goes along the top edge, or along the bottom edge when the ``avoid``
     point (the player on screen) is in the upper half, so it never hides the player."""
-    big = _font(46 if panel.where == "top" else 32)
-    small = _font(22)
-    title = big.render(panel.title, True, panel.title_color)
+    big = 46 if panel.where == "top" else 32
+    title = _render(big, panel.title, panel.title_color)
     rows = []
     for i, line in enumerate(panel.lines):
         chosen = panel.choice == i
-        rows.append(small.render(("> " if chosen else "  ") + line if panel.choice is not None
-                                 else line, True, WARN if chosen else TEXT))
+        rows.append(_render(22, ("> " if chosen else "  ") + line if panel.choice is not None
+                            else line, WARN if chosen else TEXT))
     if panel.hint:
-        rows.append(small.render(panel.hint, True, TEXT_DIM))
+        rows.append(_render(22, panel.hint, TEXT_DIM))
     width = max([title.get_width()] + [r.get_width() for r in rows]) + 36
     height = title.get_height() + sum(r.get_height() + 3 for r in rows) + 26
     if panel.where == "corner":

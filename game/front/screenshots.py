@@ -132,6 +132,27 @@ def _replay() -> pygame.Surface:
     return pygame.image.load(str(shot))
 
 
+def _replay_large() -> pygame.Surface:
+    """A trace on a 48 × 100 building (too wide for the window) replayed through the camera."""
+    from game.buildings import building_level
+    from game.front.replay import ReplayViewer
+    from game.trace import load_trace
+    from game.trial import TrialSpec, run_trial
+    from navmesh.level import load_level
+
+    folder = Path(tempfile.mkdtemp())
+    level = folder / "building.json"
+    level.write_text(json.dumps(building_level(48, 100, room=10, guards=8)))
+    trace = io.StringIO()
+    run_trial(TrialSpec(str(level), "grid", "cheat", "maxmin", "fixed", seed=0,
+                        overrides=(("world.duration", 30.0),)), trace=trace)
+    (folder / "run.jsonl").write_text(trace.getvalue())
+    viewer = ReplayViewer(load_trace(str(folder / "run.jsonl")), load_level(str(level)), "grid",
+                          speed=8.0, size=SIZE, show_plans=True)
+    viewer.run(200)
+    return viewer.screen
+
+
 #: file name → what draws it (a game whose window is saved, or a ready surface).
 SHOTS: dict[str, Callable[[], PlayGame | pygame.Surface]] = {
     "play-miami-none.png": _overlay("none"),
@@ -148,6 +169,7 @@ SHOTS: dict[str, Callable[[], PlayGame | pygame.Surface]] = {
     "play-building-camera.png": _large,
     "play-chooser.png": _chooser,
     "replay-miami.png": _replay,
+    "replay-building-camera.png": _replay_large,
 }
 
 
