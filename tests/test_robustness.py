@@ -9,8 +9,10 @@ from typing import Any
 import pytest
 
 from headless.errors import UserError
+from headless.presets import load_preset
 from headless.robustness import END, SECTION, START, judge, main, write_between_markers
 from headless.store import STORE_NAME, ResultStore
+from headless.tune import load_tune_spec
 
 GUARDS = ("cheat", "pf", "staleness", "fsm", "random")
 #: capture rank (Cheat > PF > Staleness > FSM > RandomWalk, as the paper)
@@ -134,3 +136,18 @@ def test_the_command_writes_the_tables_between_markers_and_the_figure(tmp_path: 
     assert f"{START}\nnew table\n{END}" in again and again.endswith("\nafter\n")
     assert again.count(SECTION) == 1
     assert main([str(tmp_path / "nowhere")]) == 2
+
+
+def test_the_bundled_robustness_preset_and_designer_files_fit_together() -> None:
+    robustness = load_preset("paper-robustness")
+    assert robustness.n_trials == 9 * 200 * len(robustness.seeds)
+    assert [k for k, _ in robustness.factors] == ["world.player_speed", "world.view_range"]
+    assert robustness.overrides == load_preset("paper").overrides
+    study = load_tune_spec("designer-pf")
+    held = load_preset("designer-pf-heldout")
+    # the held-out preset runs exactly the study's held-out seeds of its design, with Staleness
+    assert held.seeds == tuple(range(study.seeds_train, study.seeds_train + study.seeds_test))
+    assert set(held.guards) == {*study.preset.guards, "staleness"}
+    for field in ("level_names", "abstractions", "players", "scenarios", "overrides"):
+        assert getattr(held, field) == getattr(study.preset, field), field
+    assert all(p.key.startswith("pf.") for p in study.params)  # nothing a Staleness guard reads
