@@ -237,8 +237,8 @@ def draw(judgements: Sequence[Judgement], path: Path, axes: Axes) -> None:
                 i, k = xs.index(j.cell[0]), ys.index(j.cell[1])
                 ax.add_patch(_rect(i, k, _COLOURS[j.outcome]))
                 v = j.decisive
-                ax.text(i, k, f"{v.mean:+.2f}\n{_short(v.a)}−{_short(v.b)}", ha="center",
-                        va="center", fontsize=7)
+                ax.text(i, k, f"{_short(v.a)}−{_short(v.b)}\n{v.mean:+.2f}\n"
+                        f"[{v.low:+.2f}, {v.high:+.2f}]", ha="center", va="center", fontsize=7)
             ax.set_xlim(-0.5, len(xs) - 0.5)
             ax.set_ylim(-0.5, len(ys) - 0.5)
             ax.set_xticks(range(len(xs)), [axes.tick(0, x) for x in xs], fontsize=7)
@@ -248,8 +248,8 @@ def draw(judgements: Sequence[Judgement], path: Path, axes: Axes) -> None:
             ax.set_title(f"{label(ABSTRACTION_NAMES, abstraction)}: {claim.title}", fontsize=7)
     fig.legend(handles=[Patch(color=colour, label=name) for name, colour in _COLOURS.items()],
                loc="lower center", ncol=3, fontsize=8)
-    fig.suptitle("The paper's claims per cell (paired 95 % bootstrap CI of the difference)",
-                 fontsize=9)
+    fig.suptitle("The paper's claims per factor cell. In each cell the deciding comparison "
+                 "A−B:\nmean paired difference [95 % bootstrap CI]", fontsize=9)
     fig.tight_layout(rect=(0, 0.03, 1, 0.98))
     fig.savefig(path)
 
