@@ -144,7 +144,7 @@ def test_the_bundled_robustness_preset_and_designer_files_fit_together() -> None
     assert [k for k, _ in robustness.factors] == ["world.player_speed", "world.view_range"]
     assert robustness.overrides == load_preset("paper").overrides
     study = load_tune_spec("designer-pf")
-    held = load_preset("designer-pf-heldout")
+    held = load_preset("pf-designer-heldout")
     # the held-out preset runs exactly the study's held-out seeds of its design, with Staleness
     assert held.seeds == tuple(range(study.seeds_train, study.seeds_train + study.seeds_test))
     assert set(held.guards) == {*study.preset.guards, "staleness"}
