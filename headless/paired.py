@@ -83,7 +83,7 @@ def paired_rows(arm: Path, control: Path, guards: str | None = None,
 
 def paired_table(rows: Sequence[Mapping[str, Any]], arm: str = "arm",
                  control: str = "control") -> str:
-    """The rows of :func:`paired_rows` as a Markdown table."""
+    """The rows of :func:`paired_rows` with pairs as a Markdown table."""
     def cell(stat: tuple[float, tuple[float, float]], signed: bool = False) -> str:
         mean, (low, high) = stat
         fmt = "{:+.2f}" if signed else "{:.2f}"
@@ -92,7 +92,8 @@ def paired_table(rows: Sequence[Mapping[str, Any]], arm: str = "arm",
     lines = [f"| measure | env | pairs | {arm} | {control} | difference |",
              "|---|---|---|---|---|---|"]
     lines += [f"| {r['measure']} | {r['env']} | {r['pairs']} | {cell(r['arm'])} | "
-              f"{cell(r['control'])} | {cell(r['difference'], signed=True)} |" for r in rows]
+              f"{cell(r['control'])} | {cell(r['difference'], signed=True)} |" for r in rows
+              if r["pairs"]]  # a measure of a scenario neither store ran: no row
     return "\n".join(lines) + "\n"
 
 

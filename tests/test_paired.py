@@ -6,7 +6,7 @@ from pathlib import Path
 
 import pytest
 
-from headless.paired import main, paired_rows
+from headless.paired import main, paired_rows, paired_table
 from headless.presets import load_preset
 from headless.sweep import run_sweep
 
@@ -66,3 +66,13 @@ def test_control_guards_pair_two_guard_modes_of_one_store(tmp_path: Path) -> Non
         assert row["difference"][0] == pytest.approx(row["arm"][0] - row["control"][0])
     assert main([str(out), str(out), "--guards", "cheat", "--control-guards", "random"]) == 0
     assert main([str(out), str(out), "--control-guards", "random"]) == 2
+
+
+def test_a_measure_without_pairs_has_no_row(tmp_path: Path) -> None:
+    preset = tmp_path / "fixed.toml"
+    preset.write_text(TINY.format(extra="").replace('scenarios = ["capture", "fixed"]',
+                                                    'scenarios = ["fixed"]'), encoding="utf-8")
+    out = tmp_path / "fixed"
+    run_sweep(load_preset(str(preset)), out, workers=1, progress=False)
+    table = paired_table(paired_rows(out, out))
+    assert "CaptureRate" not in table and "| CapturesInTime | grid | 3 |" in table
