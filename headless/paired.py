@@ -33,9 +33,12 @@ MEASURES: tuple[tuple[str, str, str, float | None], ...] = (
 _PAIR_KEY = ("level", "abstraction", "guards", "player", "scenario", "seed")
 
 
-def _load(directory: Path, guards: str | None) -> dict[tuple[Any, ...], Mapping[str, Any]]:
+def _load(directory: Path, guards: str | None, across: bool = False,
+          ) -> dict[tuple[Any, ...], Mapping[str, Any]]:
+    """Trials by pair key (without the guard mode when pairing ``across`` modes)."""
+    key = tuple(k for k in _PAIR_KEY if not (across and k == "guards"))
     with ResultStore(directory / STORE_NAME, readonly=True) as store:
-        return {tuple(t[k] for k in _PAIR_KEY): t for t in store.trials()
+        return {tuple(t[k] for k in key): t for t in store.trials()
                 if guards is None or t["guards"] == guards}
 
 
@@ -48,14 +51,23 @@ def _value(trial: Mapping[str, Any], metric: str, missing: float | None) -> floa
     return float(value)
 
 
-def paired_rows(arm: Path, control: Path, guards: str | None = None) -> list[dict[str, Any]]:
-    """Per measure and abstraction (and both together): pairs, means, CIs, difference."""
-    a, c = _load(arm, guards), _load(control, guards)
+def paired_rows(arm: Path, control: Path, guards: str | None = None,
+                control_guards: str | None = None) -> list[dict[str, Any]]:
+    """Per measure and abstraction (and both together): pairs, means, CIs, difference.
+
+    ``control_guards`` pairs the arm's ``guards`` trials with that mode's in the control.
+    """
+    if control_guards is not None and guards is None:
+        raise ValueError("control_guards needs guards")
+    across = control_guards is not None
+    a = _load(arm, guards, across)
+    c = _load(control, control_guards if across else guards, across)
+    scenario_at = _PAIR_KEY.index("scenario") - (1 if across else 0)
     keys = sorted(set(a) & set(c))
     out = []
     for name, scenario, metric, missing in MEASURES:
         for env in (*sorted({k[1] for k in keys}), "both"):
-            ks = [k for k in keys if k[4] == scenario and env in (k[1], "both")]
+            ks = [k for k in keys if k[scenario_at] == scenario and env in (k[1], "both")]
             x = np.array([_value(a[k], metric, missing) for k in ks])
             y = np.array([_value(c[k], metric, missing) for k in ks])
             label = f"paired/{name}/{env}"
@@ -71,7 +83,7 @@ def paired_rows(arm: Path, control: Path, guards: str | None = None) -> list[dic
 
 def paired_table(rows: Sequence[Mapping[str, Any]], arm: str = "arm",
                  control: str = "control") -> str:
-    """The rows of :func:`paired_rows` as a Markdown table."""
+    """The rows of :func:`paired_rows` with pairs as a Markdown table."""
     def cell(stat: tuple[float, tuple[float, float]], signed: bool = False) -> str:
         mean, (low, high) = stat
         fmt = "{:+.2f}" if signed else "{:.2f}"
@@ -80,7 +92,8 @@ def paired_table(rows: Sequence[Mapping[str, Any]], arm: str = "arm",
     lines = [f"| measure | env | pairs | {arm} | {control} | difference |",
              "|---|---|---|---|---|---|"]
     lines += [f"| {r['measure']} | {r['env']} | {r['pairs']} | {cell(r['arm'])} | "
-              f"{cell(r['control'])} | {cell(r['difference'], signed=True)} |" for r in rows]
+              f"{cell(r['control'])} | {cell(r['difference'], signed=True)} |" for r in rows
+              if r["pairs"]]  # a measure of a scenario neither store ran: no row
     return "\n".join(lines) + "\n"
 
 
@@ -90,6 +103,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser.add_argument("arm", type=Path, help="results directory of the arm")
     parser.add_argument("control", type=Path, help="results directory of the control")
     parser.add_argument("--guards", default=None, help="only trials of this guard mode")
+    parser.add_argument("--control-guards", default=None,
+                        help="pair with this guard mode's trials of the control (needs --guards)")
     parser.add_argument("--names", nargs=2, default=("arm", "control"),
                         metavar=("ARM", "CONTROL"), help="column titles")
     args = parser.parse_args(argv)
@@ -97,7 +112,11 @@ def main(argv: Sequence[str] | None = None) -> int:
         if not (directory / STORE_NAME).is_file():
             print(f"stealth: error: {directory}: no {STORE_NAME} here", file=sys.stderr)
             return 2
-    sys.stdout.write(paired_table(paired_rows(args.arm, args.control, args.guards), *args.names))
+    if args.control_guards is not None and args.guards is None:
+        print("stealth: error: --control-guards needs --guards", file=sys.stderr)
+        return 2
+    rows = paired_rows(args.arm, args.control, args.guards, args.control_guards)
+    sys.stdout.write(paired_table(rows, *args.names))
     return 0
 
 

@@ -4,7 +4,9 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from headless.paired import main, paired_rows
+import pytest
+
+from headless.paired import main, paired_rows, paired_table
 from headless.presets import load_preset
 from headless.sweep import run_sweep
 
@@ -45,3 +47,32 @@ def test_the_command_prints_a_table_and_refuses_a_missing_store(tmp_path: Path) 
     control = _sweep(tmp_path, "control")
     assert main([str(control), str(control), "--names", "a", "b"]) == 0
     assert main([str(control), str(tmp_path / "nowhere")]) == 2
+
+
+def test_control_guards_pair_two_guard_modes_of_one_store(tmp_path: Path) -> None:
+    preset = tmp_path / "two.toml"
+    preset.write_text(TINY.format(extra="").replace('guards = ["cheat"]',
+                                                    'guards = ["cheat", "random"]'),
+                      encoding="utf-8")
+    out = tmp_path / "two"
+    run_sweep(load_preset(str(preset)), out, workers=1, progress=False)
+    across = {(r["measure"], r["env"]): r
+              for r in paired_rows(out, out, guards="cheat", control_guards="random")}
+    cheat = {(r["measure"], r["env"]): r for r in paired_rows(out, out, guards="cheat")}
+    walk = {(r["measure"], r["env"]): r for r in paired_rows(out, out, guards="random")}
+    for key, row in across.items():
+        assert row["pairs"] == 3
+        assert row["arm"] == cheat[key]["arm"] and row["control"][0] == walk[key]["arm"][0]
+        assert row["difference"][0] == pytest.approx(row["arm"][0] - row["control"][0])
+    assert main([str(out), str(out), "--guards", "cheat", "--control-guards", "random"]) == 0
+    assert main([str(out), str(out), "--control-guards", "random"]) == 2
+
+
+def test_a_measure_without_pairs_has_no_row(tmp_path: Path) -> None:
+    preset = tmp_path / "fixed.toml"
+    preset.write_text(TINY.format(extra="").replace('scenarios = ["capture", "fixed"]',
+                                                    'scenarios = ["fixed"]'), encoding="utf-8")
+    out = tmp_path / "fixed"
+    run_sweep(load_preset(str(preset)), out, workers=1, progress=False)
+    table = paired_table(paired_rows(out, out))
+    assert "CaptureRate" not in table and "| CapturesInTime | grid | 3 |" in table
