@@ -37,8 +37,10 @@ def building_occupancy(rows: int, cols: int, seed: int = 0) -> np.ndarray:
         for c0 in range(0, cols, block):
             r1, c1 = min(r0 + block, rows - 1), min(c0 + block, cols - 1)
             # one wall around the block, then split it into 2-3 rooms each way
-            wall[r0 + 2 : r1 - 1, [max(c0 + 2, 1), max(c1 - 2, 1)]] = True
-            wall[[max(r0 + 2, 1), max(r1 - 2, 1)], c0 + 2 : c1 - 1] = True
+            # a last block narrower than a room puts its near wall on (or past) the border:
+            # clamped onto the border column/row, which ``walk`` then removes
+            wall[r0 + 2 : r1 - 1, [min(max(c0 + 2, 1), cols - 1), max(c1 - 2, 1)]] = True
+            wall[[min(max(r0 + 2, 1), rows - 1), max(r1 - 2, 1)], c0 + 2 : c1 - 1] = True
             cuts_r = sorted(rng.choice(np.arange(r0 + 7, max(r0 + 8, r1 - 6)), size=1))
             cuts_c = sorted(rng.choice(np.arange(c0 + 7, max(c0 + 8, c1 - 6)), size=1))
             for r in cuts_r:
