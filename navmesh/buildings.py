@@ -22,7 +22,12 @@ from .level import FORMAT
 
 
 def building_occupancy(rows: int, cols: int, seed: int = 0) -> np.ndarray:
-    """(rows, cols) bool, True = walkable: rooms, corridors, doors and furniture, one piece."""
+    """(rows, cols) bool, True = walkable: rooms, corridors, doors and furniture, one piece.
+
+    Any size from 3 × 3 (one walkable cell inside the border wall); smaller raises ValueError.
+    """
+    if rows < 3 or cols < 3:
+        raise ValueError(f"a building needs at least 3x3 cells (a wall all round), got {rows}x{cols}")
     rng = np.random.default_rng(seed)
     walk = np.zeros((rows, cols), dtype=bool)
     walk[1:-1, 1:-1] = True
