@@ -21,7 +21,7 @@ waiting for a core, and in a real window for the X server). The first line, a ba
 that only fills and flips, says what the display itself costs at that moment.
 
 ``--game-building RxC``: the whole game (world, AI, scene, drawing) on a generated
-building level (:func:`game.buildings.building_level`) with the camera zoomed in and
+building level (:func:`navmesh.buildings.building_level`) with the camera zoomed in and
 following the MaxMin autopilot, the minimap on. ``--building RxC``: the front end alone on
 a building of R×C cells (10^6 with 1000x1000) — a level too large for the simulation's
 all-pairs distance tables — with 12 guards walking around the player, their cones cast
@@ -57,7 +57,7 @@ from pathlib import Path
 
 import numpy as np
 
-from game.buildings import building_level
+from navmesh.buildings import building_level
 from game.front.play import PlayGame, PlaySettings
 from game.front.render import Renderer, init_pygame, pygame
 from game.scene import OVERLAYS, GuardDrawing, PlayerDrawing, Scene, SceneBuilder
@@ -103,7 +103,7 @@ def _size(text: str) -> tuple[int, int]:
 def measure_game_building(rows: int, cols: int, frames: int, warmup: int) -> Times:
     """The whole game on a generated building, camera zoomed in on the autopilot."""
     path = Path(tempfile.mkdtemp()) / "building.json"
-    path.write_text(json.dumps(building_level(rows, cols, room=12, guards=8)))
+    path.write_text(json.dumps(building_level(rows, cols, guards=8)))
     game = PlayGame(PlaySettings(str(path), guards="pf", autopilot="maxmin", overlay="K",
                                  show_plans=True), lockstep=True, size=(1280, 860))
     game.camera.zoom = 24.0
@@ -129,7 +129,7 @@ class _GridOnly:
 
 def measure_front_building(rows: int, cols: int, frames: int, warmup: int) -> tuple[Times, int]:
     """The front end alone on a building of rows × cols cells (see the module docstring)."""
-    level = parse_level(building_level(rows, cols, room=12, guards=12))
+    level = parse_level(building_level(rows, cols, guards=12))
     graph = _GridOnly(level.occupancy, level.cell_size)
     builder = SceneBuilder(level, graph, view_range=8.0, fov_deg=90.0)  # type: ignore[arg-type]
     init_pygame()

@@ -22,7 +22,12 @@ from .level import FORMAT
 
 
 def building_occupancy(rows: int, cols: int, seed: int = 0) -> np.ndarray:
-    """(rows, cols) bool, True = walkable: rooms, corridors, doors and furniture, one piece."""
+    """(rows, cols) bool, True = walkable: rooms, corridors, doors and furniture, one piece.
+
+    Any size from 3 × 3 (one walkable cell inside the border wall); smaller raises ValueError.
+    """
+    if rows < 3 or cols < 3:
+        raise ValueError(f"a building needs at least 3x3 cells (a wall all round), got {rows}x{cols}")
     rng = np.random.default_rng(seed)
     walk = np.zeros((rows, cols), dtype=bool)
     walk[1:-1, 1:-1] = True
@@ -37,8 +42,10 @@ def building_occupancy(rows: int, cols: int, seed: int = 0) -> np.ndarray:
         for c0 in range(0, cols, block):
             r1, c1 = min(r0 + block, rows - 1), min(c0 + block, cols - 1)
             # one wall around the block, then split it into 2-3 rooms each way
-            wall[r0 + 2 : r1 - 1, [max(c0 + 2, 1), max(c1 - 2, 1)]] = True
-            wall[[max(r0 + 2, 1), max(r1 - 2, 1)], c0 + 2 : c1 - 1] = True
+            # a last block narrower than a room puts its near wall on (or past) the border:
+            # clamped onto the border column/row, which ``walk`` then removes
+            wall[r0 + 2 : r1 - 1, [min(max(c0 + 2, 1), cols - 1), max(c1 - 2, 1)]] = True
+            wall[[min(max(r0 + 2, 1), rows - 1), max(r1 - 2, 1)], c0 + 2 : c1 - 1] = True
             cuts_r = sorted(rng.choice(np.arange(r0 + 7, max(r0 + 8, r1 - 6)), size=1))
             cuts_c = sorted(rng.choice(np.arange(c0 + 7, max(c0 + 8, c1 - 6)), size=1))
             for r in cuts_r:

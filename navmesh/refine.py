@@ -13,9 +13,14 @@ import math
 
 import numpy as np
 
-from navmesh.triangulate import edge_neighbors, orient_ccw
+from navmesh.predicates import degenerate_candidates, flip_candidates, quality_candidates, small_angle_candidates
+from navmesh.rings import ring_neighbours
+from navmesh.triangulate import edge_neighbors, orient_ccw, vertex_ids
 
 __all__ = ["Refiner", "fix_degenerate"]
+
+
+_NEXT, _PREV = (1, 2, 0), (2, 0, 1)  # (k + 1) % 3 and (k + 2) % 3
 
 
 def _orient2(ax: float, ay: float, bx: float, by: float, cx: float, cy: float) -> float:
@@ -33,30 +38,31 @@ class Refiner:
     def __init__(self, verts: np.ndarray, tris: np.ndarray, rings: list[np.ndarray], tol: float) -> None:
         self.x: list[float] = verts[:, 0].tolist()
         self.y: list[float] = verts[:, 1].tolist()
+        nbr = edge_neighbors(tris)
         self.tri: list[list[int]] = tris.tolist()
-        self.nbr: list[list[int]] = edge_neighbors(tris).tolist()
+        self.nbr: list[list[int]] = nbr.tolist()
         self.tol = tol
         self.dirty: list[int] = []
         self.n_input = len(verts)
-        # input segments and the input angle at every input vertex (for the small-angle rule)
-        lookup = {(float(x), float(y)): i for i, (x, y) in enumerate(verts)}
+        # input segments and the input angle at every input vertex (for the small-angle rule);
+        # numpy picks the vertices that may be below 60 degrees, the scalar test decides
         self.small: set[int] = set()
-        for ring in rings:
-            ids = [lookup[(float(x), float(y))] for x, y in ring]
-            for j, v in enumerate(ids):
-                p, n = ids[j - 1], ids[(j + 1) % len(ids)]
-                # walkable (interior) angle: counter-clockwise from the next to the previous vertex
-                ux, uy = self.x[n] - self.x[v], self.y[n] - self.y[v]
-                wx, wy = self.x[p] - self.x[v], self.y[p] - self.y[v]
-                ang = math.atan2(ux * wy - uy * wx, ux * wx + uy * wy) % (2.0 * math.pi)
-                if ang < math.radians(60.0):
-                    self.small.add(v)
+        limit = math.radians(60.0)
+        allv = np.concatenate(rings)
+        prv, nxt = ring_neighbours([len(r) for r in rings])
+        maybe = np.flatnonzero(small_angle_candidates(allv[:, 0], allv[:, 1], prv, nxt, limit))
+        ids = vertex_ids(verts, allv)
+        for v, p, n in zip(ids[maybe].tolist(), ids[prv[maybe]].tolist(), ids[nxt[maybe]].tolist()):
+            # walkable (interior) angle: counter-clockwise from the next to the previous vertex
+            ux, uy = self.x[n] - self.x[v], self.y[n] - self.y[v]
+            wx, wy = self.x[p] - self.x[v], self.y[p] - self.y[v]
+            ang = math.atan2(ux * wy - uy * wx, ux * wx + uy * wy) % (2.0 * math.pi)
+            if ang < limit:
+                self.small.add(v)
         self.on_seg: dict[int, tuple[int, int]] = {}  # Steiner vertex -> input segment end points
-        self.bound: dict[tuple[int, int], int] = {}  # directed boundary edge -> triangle
-        for t, (tri, nb) in enumerate(zip(self.tri, self.nbr)):
-            for k in range(3):
-                if nb[k] < 0:
-                    self.bound[(tri[(k + 1) % 3], tri[(k + 2) % 3])] = t
+        bt, bk = np.nonzero(nbr < 0)
+        ends = zip(tris[bt, (bk + 1) % 3].tolist(), tris[bt, (bk + 2) % 3].tolist())
+        self.bound: dict[tuple[int, int], int] = dict(zip(ends, bt.tolist()))  # directed boundary edge -> triangle
 
     # -------------------------------------------------------------- primitives
     def _orient(self, a: int, b: int, c: int) -> float:
@@ -80,15 +86,31 @@ class Refiner:
             nb[nb.index(old)] = new
 
     def _should_flip(self, t: int, k: int) -> bool:
+        """Whether edge k of t is not locally Delaunay and its quad is convex (so it flips).
+
+        :meth:`_incircle` and :meth:`_orient` written out (the hottest test of the
+        refinement): the same operations in the same order.
+        """
         u = self.nbr[t][k]
         if u < 0:
             return False
         tri = self.tri[t]
-        a, b, c = tri[k], tri[(k + 1) % 3], tri[(k + 2) % 3]
+        a, b, c = tri[k], tri[_NEXT[k]], tri[_PREV[k]]
         d = self.tri[u][self.nbr[u].index(t)]
-        if self._incircle(a, b, c, d) <= 1e-12:
+        x, y = self.x, self.y
+        xa, ya, xd, yd = x[a], y[a], x[d], y[d]
+        adx, ady = xa - xd, ya - yd
+        bdx, bdy = x[b] - xd, y[b] - yd
+        cdx, cdy = x[c] - xd, y[c] - yd
+        ad, bd, cd = adx * adx + ady * ady, bdx * bdx + bdy * bdy, cdx * cdx + cdy * cdy
+        scale = max(ad, bd, cd)
+        if not scale > 0:
             return False
-        return self._orient(a, b, d) > 0 and self._orient(a, d, c) > 0
+        det = adx * (bdy * cd - bd * cdy) - ady * (bdx * cd - bd * cdx) + ad * (bdx * cdy - bdy * cdx)
+        if det / (scale * scale) <= 1e-12:
+            return False
+        return ((x[b] - xa) * (yd - ya) - (y[b] - ya) * (xd - xa) > 0
+                and (xd - xa) * (y[c] - ya) - (yd - ya) * (x[c] - xa) > 0)
 
     def _flip(self, t: int, k: int) -> int:
         """Flip the edge opposite vertex k of t; afterwards both t and u start with that vertex."""
@@ -113,12 +135,37 @@ class Refiner:
         return u
 
     def legalize_all(self) -> None:
-        """Lawson flips until every interior edge is locally Delaunay (any triangulation -> CDT)."""
-        stack = [(t, k) for t in range(len(self.tri)) for k in range(3)]
-        while stack:
-            t, k = stack.pop()
+        """Lawson flips until every interior edge is locally Delaunay (any triangulation -> CDT).
+
+        Every edge (t, k) is tested from the last to the first, each flip's four outer
+        edges first.  An edge whose two triangles no flip has touched yet keeps the result
+        numpy found for it up front (:func:`flip_candidates`), so only candidates and
+        touched triangles are tested one by one: the same flips in the same order.
+        """
+        n = len(self.tri)
+        maybe = flip_candidates(np.asarray(self.x), np.asarray(self.y), np.asarray(self.tri, dtype=np.int64),
+                                np.asarray(self.nbr, dtype=np.int64), 1e-12).tolist()
+        touched = bytearray(n)
+        stack: list[tuple[int, int]] = []
+        t_next = n - 1  # the untested initial items are (t, k) for t <= t_next, k <= k_next
+        k_next = 2
+        while True:
+            if stack:
+                t, k = stack.pop()
+            else:
+                while t_next >= 0 and not touched[t_next] and not any(maybe[t_next][: k_next + 1]):
+                    t_next, k_next = t_next - 1, 2
+                if t_next < 0:
+                    return
+                t, k = t_next, k_next
+                t_next, k_next = (t_next, k_next - 1) if k_next else (t_next - 1, 2)
+                if not touched[t] and not maybe[t][k]:
+                    continue
             if self._should_flip(t, k):
                 u = self._flip(t, k)
+                for s in (t, u, *self.nbr[t], *self.nbr[u]):
+                    if s >= 0:
+                        touched[s] = 1
                 stack += ((t, 0), (t, 2), (u, 0), (u, 1))
 
     def _legalize_around(self, p: int, tris: list[int]) -> None:
@@ -235,10 +282,12 @@ class Refiner:
         """< 1 when the triangle is bad (too small an angle or too large)."""
         a, b, c = self.tri[t]
         x, y = self.x, self.y
-        l0 = math.hypot(x[b] - x[c], y[b] - y[c])
-        l1 = math.hypot(x[c] - x[a], y[c] - y[a])
-        l2 = math.hypot(x[a] - x[b], y[a] - y[b])
-        area2 = _orient2(x[a], y[a], x[b], y[b], x[c], y[c])
+        xa, ya, xb, yb, xc, yc = x[a], y[a], x[b], y[b], x[c], y[c]
+        hypot = math.hypot
+        l0 = hypot(xb - xc, yb - yc)
+        l1 = hypot(xc - xa, yc - ya)
+        l2 = hypot(xa - xb, ya - yb)
+        area2 = (xb - xa) * (yc - ya) - (yb - ya) * (xc - xa)  # _orient2 written out
         lmin = min(l0, l1, l2)
         prod = l0 * l1 * l2 / lmin if lmin > 0 else math.inf
         q = (area2 / prod) / sin_min if sin_min > 0 and prod > 0 else math.inf
@@ -334,14 +383,15 @@ class Refiner:
         def scan(ts: list[int]) -> None:
             for t in dict.fromkeys(ts):
                 tri, nb = self.tri[t], self.nbr[t]
-                for k in range(3):
-                    if nb[k] < 0 and self._encroached(t, k):
-                        segq.append((tri[(k + 1) % 3], tri[(k + 2) % 3]))
+                if nb[0] < 0 or nb[1] < 0 or nb[2] < 0:
+                    for k in range(3):
+                        if nb[k] < 0 and self._encroached(t, k):
+                            segq.append((tri[(k + 1) % 3], tri[(k + 2) % 3]))
                 q = self._quality(t, sin_min, area_cap)
                 if q < 1.0:
                     heapq.heappush(badq, (q, t, tuple(tri)))
 
-        scan(list(range(len(self.tri))))
+        self._scan_all(segq, badq, sin_min, area_cap)
         self.dirty = []
         budget = max_steiner
         retries: dict[tuple[int, ...], int] = {}
@@ -385,6 +435,29 @@ class Refiner:
             ts, self.dirty = self.dirty, []
             scan(ts)
 
+    def _scan_all(self, segq: list[tuple[int, int]], badq: list[tuple[float, int, tuple[int, ...]]],
+                  sin_min: float, area_cap: float) -> None:
+        """The refinement's first scan of every triangle: what ``scan`` does on them all, with
+        numpy narrowing the scalar quality test to the triangles that may be bad."""
+        x, y = np.asarray(self.x), np.asarray(self.y)
+        tri, nbr = np.asarray(self.tri, dtype=np.int64), np.asarray(self.nbr, dtype=np.int64)
+        bt, bk = np.nonzero(nbr < 0)
+        a, b, c = tri[bt, bk], tri[bt, (bk + 1) % 3], tri[bt, (bk + 2) % 3]
+        enc = (x[b] - x[a]) * (x[c] - x[a]) + (y[b] - y[a]) * (y[c] - y[a]) < 0.0  # _encroached
+        maybe_bad = quality_candidates(x, y, tri, sin_min, area_cap)
+        # scan's order: triangle by triangle, its encroached edges (k ascending), then its quality
+        bad = np.flatnonzero(maybe_bad)
+        tri_of = np.concatenate([bt[enc], bad])
+        order = np.argsort(tri_of, kind="stable")
+        seg_of = np.concatenate([np.column_stack([b[enc], c[enc]]), np.full((len(bad), 2), -1)])[order]
+        for t, (seg_b, seg_c) in zip(tri_of[order].tolist(), seg_of.tolist()):
+            if seg_b >= 0:
+                segq.append((seg_b, seg_c))
+                continue
+            q = self._quality(t, sin_min, area_cap)
+            if q < 1.0:
+                heapq.heappush(badq, (q, t, tuple(self.tri[t])))
+
     def _insert_point(self, t: int, px: float, py: float) -> None:
         tri = self.tri[t]
         x, y = self.x, self.y
@@ -427,15 +500,22 @@ def fix_degenerate(verts: np.ndarray, tris: np.ndarray, tol: float) -> np.ndarra
         longest = max(math.hypot(ref.x[q] - ref.x[r], ref.y[q] - ref.y[r]) for q, r in ((b, c), (c, a), (a, b)))
         return ref._orient(a, b, c) <= tol * longest
 
+    # the first flat triangle each time: numpy lists those that may be flat, a heap keeps
+    # them and the triangles each flip changes in index order, the scalar test decides
+    x, y = np.asarray(ref.x), np.asarray(ref.y)
+    maybe = np.flatnonzero(degenerate_candidates(x, y, tris, tol)).tolist()
+    heapq.heapify(maybe)
     for _ in range(len(tris) + 1):
-        bad = next((t for t in range(len(ref.tri)) if flat(t)), None)
-        if bad is None:
+        while maybe and not flat(maybe[0]):
+            heapq.heappop(maybe)
+        if not maybe:
             break
+        bad = maybe[0]
         a, b, c = ref.tri[bad]
         # the vertex lying between the other two is opposite the long edge: flip that edge
         lens = [math.hypot(ref.x[q] - ref.x[r], ref.y[q] - ref.y[r]) for q, r in ((b, c), (c, a), (a, b))]
         k = int(np.argmax(lens))
         if ref.nbr[bad][k] < 0:
             raise ValueError("degenerate triangle on the boundary: a vertex lies on a wall")
-        ref._flip(bad, k)
+        heapq.heappush(maybe, ref._flip(bad, k))
     return orient_ccw(verts, np.asarray(ref.tri, dtype=np.int64))

@@ -14,7 +14,7 @@ from scipy.spatial import cKDTree
 from shapely.geometry import Polygon
 from shapely.geometry.polygon import orient
 
-__all__ = ["polygon_rings"]
+__all__ = ["polygon_rings", "ring_neighbours"]
 
 
 def polygon_rings(polygon: Polygon, tol: float) -> list[np.ndarray]:
@@ -36,10 +36,27 @@ def polygon_rings(polygon: Polygon, tol: float) -> list[np.ndarray]:
     poly = orient(polygon, sign=1.0)
     rings = [np.asarray(poly.exterior.coords, dtype=np.float64)[:-1, :2]]
     rings += [np.asarray(r.coords, dtype=np.float64)[:-1, :2] for r in poly.interiors]
-    rings = [_drop_repeats(r, tol) for r in rings]
+    rings = _drop_repeats_all(rings, tol)
     rings = _insert_touching(rings, tol)
     rings = _drop_straight(rings, tol)
     return rings
+
+
+def ring_neighbours(lengths: list[int]) -> tuple[np.ndarray, np.ndarray]:
+    """Index of the previous and the next point of every point of rings laid end to end.
+
+    What ``np.roll(ring, ±1)`` gives per ring, for all rings at once: a level of 10^4
+    holes would otherwise pay numpy's per-call overhead 10^4 times per pass.
+    """
+    n = np.asarray(lengths, dtype=np.intp)
+    start = np.repeat(np.cumsum(n) - n, n)
+    pos = np.arange(int(n.sum()), dtype=np.intp) - start
+    size = np.repeat(n, n)
+    return start + (pos - 1) % size, start + (pos + 1) % size
+
+
+def _split(values: np.ndarray, lengths: list[int] | np.ndarray) -> list[np.ndarray]:
+    return np.split(values, np.cumsum(lengths)[:-1])
 
 
 def _drop_repeats(ring: np.ndarray, tol: float) -> np.ndarray:
@@ -48,64 +65,93 @@ def _drop_repeats(ring: np.ndarray, tol: float) -> np.ndarray:
     return ring[keep]
 
 
+def _drop_repeats_all(rings: list[np.ndarray], tol: float) -> list[np.ndarray]:
+    """:func:`_drop_repeats` of every ring (the same test, on all rings at once)."""
+    lengths = [len(r) for r in rings]
+    allv = np.concatenate(rings)
+    _, nxt = ring_neighbours(lengths)
+    keep = np.hypot(*(allv[nxt] - allv).T) > tol
+    kept = [int(k.sum()) for k in _split(keep, lengths)]
+    return _split(allv[keep], kept)
+
+
 def _insert_touching(rings: list[np.ndarray], tol: float) -> list[np.ndarray]:
     """Insert into each edge the vertices of any ring that lie strictly inside it.
 
     Only the vertices within half an edge (plus the tolerance) of its midpoint can lie on
     it, so a k-d tree gives the candidates: linear in the corners rather than edges ×
-    corners (a 1000×1000-cell outline has ~10^5 of each).
+    corners (a 1000×1000-cell outline has ~10^5 of each).  All rings' edges are tested
+    at once; only a ring with a hit is rebuilt point by point.
     """
+    lengths = [len(r) for r in rings]
     allv = np.concatenate(rings)
     tree = cKDTree(allv)
+    _, nxt = ring_neighbours(lengths)
+    a, b = allv, allv[nxt]
+    e = b - a
+    le2 = np.einsum("ij,ij->i", e, e)
+    le = np.sqrt(le2)
+    near = tree.query_ball_point((a + b) / 2.0, le / 2.0 + 2.0 * tol + 1e-12, return_sorted=True)
+    counts = np.fromiter((len(c) for c in near), dtype=np.intp, count=len(near))
+    edge = np.repeat(np.arange(len(allv)), counts)
+    vert = np.fromiter((v for c in near for v in c), dtype=np.intp, count=int(counts.sum()))
+    rel = allv[vert] - a[edge]
+    ee = e[edge]
+    t = np.einsum("ij,ij->i", rel, ee) / le2[edge]
+    dist = np.abs(ee[:, 0] * rel[:, 1] - ee[:, 1] * rel[:, 0]) / le[edge]
+    lp = le[edge]
+    on = (dist <= tol) & (t * lp > tol) & ((1.0 - t) * lp > tol)
+    hits: dict[int, list[int]] = {}
+    for k in np.flatnonzero(on).tolist():
+        hits.setdefault(int(edge[k]), []).append(k)
+    ring_of = np.repeat(np.arange(len(rings)), lengths)
+    touched = set(ring_of[list(hits)].tolist())
     out = []
-    for ring in rings:
-        a, b = ring, np.roll(ring, -1, axis=0)
-        e = b - a
-        le2 = np.einsum("ij,ij->i", e, e)
-        le = np.sqrt(le2)
-        near = tree.query_ball_point((a + b) / 2.0, le / 2.0 + 2.0 * tol + 1e-12, return_sorted=True)
-        counts = np.fromiter((len(c) for c in near), dtype=np.intp, count=len(near))
-        edge = np.repeat(np.arange(len(ring)), counts)
-        vert = np.fromiter((v for c in near for v in c), dtype=np.intp, count=int(counts.sum()))
-        rel = allv[vert] - a[edge]
-        ee = e[edge]
-        t = np.einsum("ij,ij->i", rel, ee) / le2[edge]
-        dist = np.abs(ee[:, 0] * rel[:, 1] - ee[:, 1] * rel[:, 0]) / le[edge]
-        lp = le[edge]
-        on = (dist <= tol) & (t * lp > tol) & ((1.0 - t) * lp > tol)
-        if not on.any():
-            out.append(ring)
-            continue
-        hits: dict[int, list[int]] = {}
-        for k in np.flatnonzero(on):
-            hits.setdefault(int(edge[k]), []).append(int(k))
-        pts: list[np.ndarray] = []
-        for i in range(len(ring)):
-            pts.append(ring[i : i + 1])
-            if i in hits:
-                ks = np.asarray(hits[i])
-                pts.append(allv[vert[ks[np.argsort(t[ks])]]])
-        out.append(_drop_repeats(np.concatenate(pts), tol))
+    start = 0
+    for r, ring in enumerate(rings):
+        if r in touched:
+            pts: list[np.ndarray] = []
+            for i in range(len(ring)):
+                pts.append(ring[i : i + 1])
+                if start + i in hits:
+                    ks = np.asarray(hits[start + i])
+                    pts.append(allv[vert[ks[np.argsort(t[ks])]]])
+            ring = _drop_repeats(np.concatenate(pts), tol)
+        out.append(ring)
+        start += lengths[r]
     return out
 
 
+def _straight(ring: np.ndarray, prv: np.ndarray, nxt: np.ndarray, shared: np.ndarray, tol: float) -> np.ndarray:
+    """Vertices where the ring goes straight on (not shared with another ring)."""
+    u, v = ring - ring[prv], ring[nxt] - ring
+    cr = u[:, 0] * v[:, 1] - u[:, 1] * v[:, 0]
+    dot = np.einsum("ij,ij->i", u, v)
+    lu, lv = np.hypot(*u.T), np.hypot(*v.T)
+    return (np.abs(cr) <= tol * np.maximum(lu, lv)) & (dot > 0) & ~shared
+
+
 def _drop_straight(rings: list[np.ndarray], tol: float) -> list[np.ndarray]:
-    """Remove vertices where a ring goes straight on, unless another ring touches there."""
+    """Remove vertices where a ring goes straight on, unless another ring touches there.
+
+    The first pass tests every ring at once; a ring with a straight vertex is then thinned
+    pass by pass on its own.
+    """
+    lengths = [len(r) for r in rings]
     allv = np.concatenate(rings)
     _, inv, counts = np.unique(allv, axis=0, return_inverse=True, return_counts=True)
     shared = counts[inv.ravel()] > 1
+    prv, nxt = ring_neighbours(lengths)
+    first = np.concatenate(([0], np.cumsum(_straight(allv, prv, nxt, shared, tol))))
+    ends = np.cumsum(lengths)
     out, start = [], 0
-    for ring in rings:
-        n = len(ring)
+    for ring, n, any_straight in zip(rings, lengths, (first[ends] - first[ends - lengths] > 0).tolist(),
+                                     strict=True):
         sh = shared[start : start + n]
         start += n
-        while True:
-            prv, nxt = np.roll(ring, 1, axis=0), np.roll(ring, -1, axis=0)
-            u, v = ring - prv, nxt - ring
-            cr = u[:, 0] * v[:, 1] - u[:, 1] * v[:, 0]
-            dot = np.einsum("ij,ij->i", u, v)
-            lu, lv = np.hypot(*u.T), np.hypot(*v.T)
-            straight = (np.abs(cr) <= tol * np.maximum(lu, lv)) & (dot > 0) & ~sh
+        while any_straight:
+            idx = np.arange(len(ring))
+            straight = _straight(ring, np.roll(idx, 1), np.roll(idx, -1), sh, tol)
             if not straight.any() or len(ring) - straight.sum() < 3:
                 break
             # drop every other straight vertex per pass so neighbours stay valid references

@@ -13,22 +13,44 @@ import numpy as np
 import shapely
 from shapely.geometry import Polygon
 
-__all__ = ["cross2", "edge_neighbors", "orient_ccw", "split_t_junctions", "triangulate_cdt", "triangulate_earcut", "wall_edges"]
+__all__ = ["cross2", "edge_neighbors", "orient_ccw", "split_t_junctions", "triangulate_cdt", "ring_vertex_ids", "triangulate_earcut", "vertex_ids", "wall_edges"]
 
 
 def triangulate_cdt(rings: list[np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
     """Constrained Delaunay triangulation of the rings (GEOS, via shapely)."""
-    poly = Polygon(rings[0], rings[1:])
+    holes = rings[1:]
+    if holes:  # every hole in one call (10^4 holes one by one cost more than the rest here)
+        index = np.repeat(np.arange(len(holes)), [len(h) for h in holes])
+        poly = shapely.polygons(rings[0], holes=shapely.linearrings(np.concatenate(holes), indices=index))
+    else:
+        poly = Polygon(rings[0])
     tris = shapely.constrained_delaunay_triangles(poly)
-    coords = shapely.get_coordinates(shapely.get_exterior_ring(np.asarray(tris.geoms)))
-    coords = coords.reshape(-1, 4, 2)[:, :3]
+    # a collection of triangles: each one's closed exterior ring, 4 points, in order
+    coords = shapely.get_coordinates(tris).reshape(-1, 4, 2)[:, :3]
     verts = np.unique(np.concatenate(rings), axis=0)
-    lookup = {(float(x), float(y)): i for i, (x, y) in enumerate(verts)}
     try:
-        triangles = np.array([[lookup[(float(x), float(y))] for x, y in tri] for tri in coords], dtype=np.int64)
+        triangles = vertex_ids(verts, coords.reshape(-1, 2))
     except KeyError as exc:  # GEOS never adds points; be loud if it ever does
         raise RuntimeError(f"constrained Delaunay output has a vertex not in the input: {exc}") from None
     return verts, triangles.reshape(-1, 3)
+
+
+def vertex_ids(verts: np.ndarray, points: np.ndarray) -> np.ndarray:
+    """Index in ``verts`` (unique rows in ``np.unique`` order) of every point, by exact equality.
+
+    One binary search per point on the rows as complex numbers (numpy orders complex numbers
+    by real then imaginary part, the order of ``np.unique(axis=0)``) instead of a Python
+    dict per call: the same indices, about 20× faster on 10^5 corners.  Raises ``KeyError``
+    naming a point that is not a vertex.
+    """
+    keys = verts[:, 0] + 1j * verts[:, 1]
+    want = points[:, 0] + 1j * points[:, 1]
+    idx = np.minimum(np.searchsorted(keys, want), len(keys) - 1)
+    miss = np.flatnonzero(keys[idx] != want)
+    if miss.size:
+        x, y = points[miss[0]]
+        raise KeyError((float(x), float(y)))
+    return idx.astype(np.int64)
 
 
 def triangulate_earcut(rings: list[np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
@@ -117,9 +139,13 @@ def split_t_junctions(verts: np.ndarray, tris: np.ndarray, walls: set[tuple[int,
 
 def wall_edges(verts: np.ndarray, rings: list[np.ndarray]) -> set[tuple[int, int]]:
     """The ring edges as (low, high) vertex-index pairs of ``verts`` (the walls)."""
-    lookup = {(float(x), float(y)): i for i, (x, y) in enumerate(verts)}
-    walls: set[tuple[int, int]] = set()
-    for ring in rings:
-        ids = [lookup[(float(x), float(y))] for x, y in ring]
-        walls.update((min(p, q), max(p, q)) for p, q in zip(ids, ids[1:] + ids[:1]))
-    return walls
+    ids = ring_vertex_ids(verts, rings)
+    nxt = np.concatenate([np.roll(r, -1) for r in ids])
+    cur = np.concatenate(ids)
+    return set(zip(np.minimum(cur, nxt).tolist(), np.maximum(cur, nxt).tolist()))
+
+
+def ring_vertex_ids(verts: np.ndarray, rings: list[np.ndarray]) -> list[np.ndarray]:
+    """:func:`vertex_ids` of every ring's points (one search for all rings)."""
+    ids = vertex_ids(verts, np.concatenate(rings))
+    return np.split(ids, np.cumsum([len(r) for r in rings])[:-1])

@@ -15,13 +15,13 @@ import numpy as np
 import pygame
 import pytest
 
-from game.buildings import building_level
 from game.config import Config
 from game.front.effects import NoiseRings, hearing_radius
 from game.front.play import PlayGame, PlaySettings
 from game.front.screenshots import SHOTS
 from game.scene import SceneBuilder, vision_cone
 from game.trial import TrialSpec, make_world
+from navmesh.buildings import building_level
 from navmesh.graph import graph_for
 from navmesh.level import parse_level
 
@@ -123,7 +123,7 @@ def test_noise_rings_appear_where_guards_hear_a_throw() -> None:
 
 
 def test_camera_follows_zooms_and_the_static_layer_is_cached() -> None:
-    level = building_level(60, 80, room=10, guards=4)
+    level = building_level(60, 80, guards=4)
     path = Path(os.environ.get("TMPDIR", "/tmp")) / f"building-{os.getpid()}.json"
     path.write_text(json.dumps(level))
     g = PlayGame(PlaySettings(str(path), autopilot="maxmin"), lockstep=True, size=(960, 800))
@@ -151,7 +151,7 @@ def test_wall_buckets_cast_the_same_cones(monkeypatch: pytest.MonkeyPatch) -> No
     import game.scene
 
     monkeypatch.setattr(game.scene, "_BUCKET_MIN_WALLS", 10)  # buckets on a small level too
-    level = parse_level(building_level(60, 80, room=6))
+    level = parse_level(building_level(60, 80))
     builder = SceneBuilder(level, graph_for(level, "grid"), view_range=8.0, fov_deg=90.0)
     assert builder._buckets is not None
     rng = np.random.default_rng(1)

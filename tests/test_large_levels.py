@@ -8,6 +8,8 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
 
 import navmesh.graph as graph_module
 import navmesh.sizing as sizing
@@ -71,3 +73,29 @@ def test_a_level_too_big_for_the_machine_is_refused_in_one_line(
     message = str(error.value)
     assert message.startswith("maze: size: 20x20 cells, about ") and "nodes: needs about" in message
     assert "\n" not in message and "GB available" in message
+
+
+def test_a_building_of_40x50_cells_is_generated() -> None:
+    """Regression: a last block narrower than a room put a wall index past the border."""
+    level = parse_level(building_level(40, 50, seed=4))
+    assert level.occupancy.shape == (40, 50)
+
+
+@settings(max_examples=60, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(rows=st.integers(3, 90), cols=st.integers(3, 90), seed=st.integers(0, 10**6),
+       form=st.sampled_from(["grid", "polygon"]))
+def test_every_building_size_is_a_valid_level(rows: int, cols: int, seed: int, form: str) -> None:
+    level = parse_level(building_level(rows, cols, seed, form=form))
+    occupancy = building_occupancy(rows, cols, seed)
+    if form == "grid":
+        assert level.occupancy.shape == (rows, cols)
+    # an outline's grid ends at its last walkable cell (the border wall is outside it)
+    r, c = level.occupancy.shape
+    assert np.array_equal(level.occupancy, occupancy[:r, :c]) and not occupancy[r:].any()
+    assert not occupancy[:, c:].any()
+
+
+@pytest.mark.parametrize("rows,cols", [(2, 10), (10, 2), (0, 0)])
+def test_a_building_too_small_for_its_walls_is_refused(rows: int, cols: int) -> None:
+    with pytest.raises(ValueError, match="at least 3x3"):
+        building_level(rows, cols)

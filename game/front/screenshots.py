@@ -93,10 +93,10 @@ def _noise_rain() -> PlayGame:
 
 def _large() -> PlayGame:
     """A 120 × 160 building through the camera, with the minimap."""
-    from game.buildings import building_level
+    from navmesh.buildings import building_level
 
     path = Path(tempfile.mkdtemp()) / "building.json"
-    level = building_level(60, 80, room=10, guards=5)
+    level = building_level(60, 80, guards=5)
     path.write_text(json.dumps(level))
     game = _game(str(path), 0, autopilot="maxmin", overlay="C")
     game.camera.zoom = 28.0
