@@ -493,9 +493,12 @@ def _polygons_overlapping(
 ) -> list[Polygon]:
     """Each of ``values`` parsed as a polygon that must overlap ``region`` (else ``problem``)."""
     parsed = []
+    shapely.prepare(region)
     for i, raw in enumerate(values):
         polygon = _parse_polygon(raw, src, f"{field}[{i}]")
-        if region.intersection(polygon).area <= _AREA_EPS:
+        # Inside the region the overlap is the polygon itself, whose area _parse_polygon
+        # checked: the (prepared) containment test spares most levels an intersection each.
+        if not region.contains(polygon) and region.intersection(polygon).area <= _AREA_EPS:
             _fail(src, f"{field}[{i}]", problem)
         parsed.append(polygon)
     return parsed
@@ -598,6 +601,7 @@ def _polygon_geometry(
     walkable = _single_piece(walkable, src, field)
 
     ys, xs = (np.mgrid[0:rows, 0:cols] + 0.5) * cell_size
+    shapely.prepare(walkable)  # same answers; a million cell centres ~10x faster
     occupancy = shapely.contains_xy(walkable, xs, ys)
     _check_connected(occupancy, src, field)
     return walkable, occupancy
