@@ -70,6 +70,7 @@ def _keys(display: str, window: str, *keys: str, hold: float = 0.0) -> None:
             subprocess.run(["xdotool", "keyup", key], env=env, check=True)
         else:
             subprocess.run(["xdotool", "key", key], env=env, check=True)
+            time.sleep(0.2)  # one key per frame or more, even on a loaded machine
 
 
 def _sessions(folder: Path) -> list[dict[str, str]]:
