@@ -174,7 +174,7 @@ def plot_errors(ours: Sequence[Compared], path: Path, title: str) -> None:
         for r in mine:
             i, j = pairs.index((r.cell.guards, r.cell.player)), metrics.index(r.cell.metric)
             ax.text(j, i, f"{r.value:.2f}\n({r.cell.target:.2f})", ha="center", va="center",
-                    fontsize=7)
+                    fontsize=7, color="white" if abs(r.scaled) > 2.5 else "black")
             if r.within:
                 ax.add_patch(Rectangle((j - 0.5, i - 0.5), 1, 1, fill=False, lw=2.0,
                                        edgecolor="black"))
