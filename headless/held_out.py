@@ -28,7 +28,7 @@ from .objective import Cell, Target, aggregate, load_target
 from .store import ResultStore
 from .tables import ABSTRACTION_NAMES, GUARD_NAMES, PLAYER_NAMES
 
-__all__ = ["Compared", "compare", "held_out_markdown", "held_out_trials", "main",
+__all__ = ["Compared", "compare", "distance", "held_out_markdown", "held_out_trials", "main",
            "plot_errors"]
 
 _BEGIN, _END = "<!-- calibrated -->", "<!-- /calibrated -->"
@@ -98,6 +98,12 @@ def _share(rows: Sequence[Compared]) -> str:
     return f"{sum(r.within for r in rows)}/{len(rows)} ({sum(r.within for r in rows) / len(rows):.0%})"
 
 
+def distance(rows: Sequence[Compared]) -> float:
+    """The tune objective of these cells (:meth:`headless.objective.Target.distance`)."""
+    scaled = [r.scaled if math.isfinite(r.scaled) else 10.0 for r in rows]
+    return sum(e * e for e in scaled) / len(scaled)
+
+
 def held_out_markdown(ours: Sequence[Compared], seeds: str,
                       baseline: Sequence[Compared] | None = None) -> str:
     """The Markdown of the module docstring for compared cells (and a baseline's)."""
@@ -147,7 +153,9 @@ def held_out_markdown(ours: Sequence[Compared], seeds: str,
             row += f" {'' if b is None else f'{b.value:.2f}'} |"
         lines.append(row)
     within = [r for r in ours if r.cell.metric == "captured"]
-    lines += ["", f"Capture-rate cells within ±0.10: {_share(within)}."]
+    lines += ["", f"Capture-rate cells within ±0.10: {_share(within)}. The tune objective "
+              f"(mean of (error / tolerance)² over the cells): {distance(ours):.2f}"
+              + (f" (defaults: {distance(baseline):.2f})" if baseline is not None else "") + "."]
     return "\n".join(lines) + "\n"
 
 

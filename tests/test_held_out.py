@@ -7,7 +7,7 @@ from pathlib import Path
 
 import pytest
 
-from headless.held_out import compare, held_out_trials, main
+from headless.held_out import compare, distance, held_out_trials, main
 from headless.objective import aggregate, load_target
 from headless.presets import load_preset
 from headless.sweep import run_sweep
@@ -47,6 +47,7 @@ def test_only_the_held_out_seeds_count_and_cells_are_the_objectives(store: Path)
         same = [t for t in trials if t["guards"] == r.cell.guards]
         assert r.value == aggregate(same, r.cell.metric)
         assert r.within == (abs(r.value - r.cell.target) <= r.cell.tolerance)
+    assert distance(compared) == pytest.approx(target.distance(trials)[0])
 
 
 def test_the_table_goes_between_the_markers_with_errors(store: Path, tmp_path: Path) -> None:
