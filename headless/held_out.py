@@ -6,9 +6,10 @@ them as Table 3 and the tune objective do (:func:`headless.objective.aggregate`)
 per abstraction, a table whose cells are "ours (paper, error)" with ✓ where the error is
 within the objective's tolerance (±0.10 for CaptureRate, ±25 % otherwise), then the share of
 cells within tolerance per column and the capture-rate cells. ``--baseline DIR2`` adds the
-same figures for another store on the same seeds (e.g. the uncalibrated ``paper`` preset);
-``--figure PNG`` draws each cell's error in tolerances; ``--write FILE`` replaces the part of
-FILE between ``<!-- calibrated -->`` and ``<!-- /calibrated -->`` (docs/results.md).
+same figures for another store on exactly the same seeds (e.g. the uncalibrated ``paper``
+preset); ``--figure PNG`` draws each cell's error in tolerances; ``--write FILE`` replaces
+the part of FILE between ``<!-- calibrated -->`` and ``<!-- /calibrated -->``
+(docs/results.md).
 """
 
 from __future__ import annotations
@@ -81,7 +82,8 @@ def compare(trials: Sequence[Mapping[str, Any]], target: Target) -> list[Compare
     """Every target cell with the trials' Table 3 value (grouped first: one pass each)."""
     groups: dict[tuple[str, str, str], list[Mapping[str, Any]]] = {}
     for trial in trials:
-        groups.setdefault((trial["abstraction"], trial["guards"], trial["player"]), []).append(trial)
+        key = (trial["abstraction"], trial["guards"], trial["player"])
+        groups.setdefault(key, []).append(trial)
     return [Compared(c, aggregate(groups.get((c.abstraction, c.guards, c.player), []), c.metric))
             for c in target.cells]
 
@@ -95,7 +97,8 @@ def _target_for(trials: Sequence[Mapping[str, Any]], name: str) -> Target:
 
 
 def _share(rows: Sequence[Compared]) -> str:
-    return f"{sum(r.within for r in rows)}/{len(rows)} ({sum(r.within for r in rows) / len(rows):.0%})"
+    within = sum(r.within for r in rows)
+    return f"{within}/{len(rows)} ({within / len(rows):.0%})"
 
 
 def distance(rows: Sequence[Compared]) -> float:
@@ -218,9 +221,10 @@ def main(argv: Sequence[str] | None = None) -> int:
         target = _target_for(trials, args.target)
         ours = compare(trials, target)
         baseline = None
-        if args.baseline is not None:
-            baseline = compare(held_out_trials(args.baseline, args.seeds_from), target)
         seeds = sorted({int(t["seed"]) for t in trials})
+        if args.baseline is not None:  # on exactly our seeds (a store still running has fewer)
+            baseline = compare([t for t in held_out_trials(args.baseline, args.seeds_from)
+                                if int(t["seed"]) in set(seeds)], target)
         label = (f"held-out seeds {seeds[0]}–{seeds[-1]}" if len(seeds) > 1
                  else f"seed {seeds[0]}")
         text = held_out_markdown(ours, label, baseline)

@@ -27,7 +27,8 @@ def _decision_times(spec: TrialSpec) -> tuple[list[float], list[float]]:
     world = make_world(spec)
     guards: list[float] = []
     player: list[float] = []
-    ask_guard, ask_player = world.guard_ai.decide, world.player_policy.decide  # type: ignore[union-attr]
+    assert world.player_policy is not None
+    ask_guard, ask_player = world.guard_ai.decide, world.player_policy.decide
 
     def guard(i: int, view: Any) -> int:
         guards.append(view.t)
@@ -38,7 +39,7 @@ def _decision_times(spec: TrialSpec) -> tuple[list[float], list[float]]:
         return int(ask_player(view))
 
     world.guard_ai.decide = guard  # type: ignore[method-assign]
-    world.player_policy.decide = policy  # type: ignore[union-attr, method-assign]
+    world.player_policy.decide = policy  # type: ignore[method-assign]
     world.run()
     return guards, player
 

@@ -57,7 +57,8 @@ def test_the_table_goes_between_the_markers_with_errors(store: Path, tmp_path: P
     assert main([str(store), "--seeds-from", "1", "--baseline", str(store), "--figure",
                  str(figure), "--write", str(doc)]) == 0
     text = doc.read_text(encoding="utf-8")
-    assert text.startswith("a\n<!-- calibrated -->\n") and text.endswith("<!-- /calibrated -->\nb\n")
+    assert text.startswith("a\n<!-- calibrated -->\n")
+    assert text.endswith("<!-- /calibrated -->\nb\n")
     assert "old" not in text and "held-out seeds 1–2" in text
     assert "| PotentialField | MaxMin | " in text and "(0.80, " in text  # the paper's PF rate
     assert "Capture-rate cells within ±0.10: " in text and "| all cells | " in text
