@@ -39,11 +39,15 @@ if TYPE_CHECKING:
     from .config import Config
 
 __all__ = [
-    "SEED", "SPAWN_RULES", "bound_of", "check_level", "check_sections", "markdown_table",
+    "RESPAWN_RULES", "SEED", "SPAWN_RULES", "bound_of", "check_level", "check_sections", "markdown_table",
 ]
 
 SPAWN_RULES = ("random", "level")
 """``world.spawns``: guard start nodes drawn per seed, or the level's spawn points."""
+
+RESPAWN_RULES = ("farthest", "random")
+"""``world.respawn``: where the fixed-time scenario puts a captured player (game.spawns):
+the start rule's farthest hidden node, or a hidden node drawn uniformly."""
 
 SEED = Range(0, 2**63 - 1, integer=True)
 """A trial's ``seed`` and a preset's ``root_seed``: whole numbers that fit the store's
@@ -55,8 +59,11 @@ _PHYSICS_STEP = Range(0.0, 0.05, low_open=True)
 WORLD: Mapping[str, Bound] = {
     "guards": COUNT,
     "spawns": OneOf(SPAWN_RULES),
+    "respawn": OneOf(RESPAWN_RULES),
     "player_hp": POSITIVE,
     "ai_tick": POSITIVE,
+    # 0 = decide on arrival (SPEC §6); > 0 = the paper's grid decision tick (game.world)
+    "grid_decision_interval": NON_NEGATIVE,
     "physics_step": _PHYSICS_STEP,
     "physics_step_interactive": _PHYSICS_STEP,
     "duration": POSITIVE,

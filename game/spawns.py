@@ -10,7 +10,7 @@ from navmesh.graph import NodeGraph
 from navmesh.level import Level
 
 from .agents import Agent
-from .schema import SPAWN_RULES
+from .schema import RESPAWN_RULES, SPAWN_RULES
 from .senses import Senses
 
 
@@ -34,6 +34,15 @@ def level_start_node(graph: NodeGraph, level: Level, spawns: str) -> int | None:
     return graph.node_at(*level.player)
 
 
+def _seen(graph: NodeGraph, active: Sequence[Agent], senses: Senses,
+          view_range: float) -> np.ndarray:
+    """The nodes any of ``active`` could see now (:meth:`Senses.visible_points`)."""
+    visible = np.zeros(graph.n, dtype=bool)
+    for g in active:
+        visible |= senses.visible_points(g.pos, g.heading, graph.positions, view_range)
+    return visible
+
+
 def start_node(graph: NodeGraph, guards: Sequence[Agent], senses: Senses, view_range: float,
                rng: np.random.Generator) -> int:
     """The node farthest (min shortest path) from every active guard, out of their sight.
@@ -45,13 +54,33 @@ def start_node(graph: NodeGraph, guards: Sequence[Agent], senses: Senses, view_r
     if not active:
         return int(rng.integers(graph.n))
     score = graph.nearest_dist(np.array([g.node for g in active]))
-    visible = np.zeros(graph.n, dtype=bool)
-    for g in active:
-        visible |= senses.visible_points(g.pos, g.heading, graph.positions, view_range)
+    visible = _seen(graph, active, senses, view_range)
     if not visible.all():
         score = np.where(visible, -np.inf, score)
     best = np.flatnonzero(score >= score.max() - 1e-9)
     return int(best[rng.integers(len(best))])
 
 
-__all__ = ["guard_spawn_nodes", "level_start_node", "start_node"]
+def hidden_node(graph: NodeGraph, guards: Sequence[Agent], senses: Senses, view_range: float,
+                rng: np.random.Generator) -> int:
+    """A node drawn uniformly with ``rng`` among those no active guard sees now (among all
+    nodes when every node is seen): ``world.respawn = "random"``, a player that may come
+    back anywhere, near a guard's back too, but never in a guard's view."""
+    active = [g for g in guards if g.active]
+    visible = _seen(graph, active, senses, view_range)
+    candidates = np.flatnonzero(~visible) if not visible.all() else np.arange(graph.n)
+    return int(candidates[rng.integers(len(candidates))])
+
+
+def respawn_node(rule: str, graph: NodeGraph, guards: Sequence[Agent], senses: Senses,
+                 view_range: float, rng: np.random.Generator) -> int:
+    """Where a player captured in the fixed-time scenario comes back (``world.respawn``):
+    ``"farthest"`` is :func:`start_node` (SPEC §7), ``"random"`` :func:`hidden_node`."""
+    if rule == "farthest":
+        return start_node(graph, guards, senses, view_range, rng)
+    if rule == "random":
+        return hidden_node(graph, guards, senses, view_range, rng)
+    raise ValueError(f"world.respawn: expected one of {RESPAWN_RULES}, got {rule!r}")
+
+
+__all__ = ["guard_spawn_nodes", "hidden_node", "level_start_node", "respawn_node", "start_node"]

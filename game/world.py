@@ -25,7 +25,7 @@ from .health import Health
 from .metrics import Counters, world_metrics
 from .schema import check_level
 from .senses import RANGE_EPS, Senses
-from .spawns import guard_spawn_nodes, level_start_node, start_node
+from .spawns import guard_spawn_nodes, level_start_node, respawn_node, start_node
 from .team import TeamRules
 from .zones import ZoneMap
 
@@ -61,6 +61,11 @@ class World(PlayerActions):
         s = config.section(f"scenario.{scenario}")
         self.dt = float(w["physics_step_interactive"] if interactive else w["physics_step"])
         self.steps_per_tick = max(1, round(float(w["ai_tick"]) / self.dt))
+        # The paper's grid agents move one cell per decision tick: > 0 gates decisions on the
+        # grid to every this many steps (an arrived agent waits on its cell centre); 0: none.
+        interval = float(w["grid_decision_interval"]) if self.graph.mesh is None else 0.0
+        self.steps_per_decision = max(1, round(interval / self.dt)) if interval > 0 else 1
+        self.respawn = str(w["respawn"])
         self.total_steps = round(float(w["duration"]) / self.dt)
         self.end_on_capture = bool(s["end_on_capture"])
         self.view_range = float(w["view_range"]) * float(s["view_range_scale"])
@@ -177,11 +182,13 @@ class World(PlayerActions):
             return
         walk = self.locomotion
         view = None
+        decide = self.step_index % self.steps_per_decision == 0  # always, unless gated
         for i, guard in enumerate(self.guards):
-            if guard.active and guard.needs_decision:
+            if decide and guard.active and guard.needs_decision:
                 view = view or self.view()
                 walk.plan(guard, int(self.guard_ai.decide(i, view)))
-        if self.player_input is None and self.player_policy is not None and self.player.needs_decision:
+        if (decide and self.player_input is None and self.player_policy is not None
+                and self.player.needs_decision):
             view = view or self.view()
             walk.plan(self.player, int(self.player_policy.decide(view)))
             for action in self.player_policy.actions(view):
@@ -263,7 +270,8 @@ class World(PlayerActions):
             return
         # Fixed-time scenario: respawn at a fresh start position with full HP.
         self.health.heal()
-        node = self.start_node()
+        node = respawn_node(self.respawn, self.graph, self.guards, self.senses,
+                            self.view_range, self.spawn_rng)
         self.place_player(node)
         self.events.append(Event("respawn", node, self.t))
 

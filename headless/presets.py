@@ -9,7 +9,7 @@ optional ``[factors]`` table (a config key → the list of values the design cro
 :class:`~headless.errors.PresetError` naming the file and field.
 
 >>> [name for name, _ in bundled_presets()][:2]
-['paper', 'paper-pf-literal']
+['paper', 'paper-calibrated']
 """
 
 from __future__ import annotations

@@ -16,8 +16,8 @@ resumed by the same command (the trial that was running is marked failed and ask
 The TPE sampler is re-seeded before each trial from ``sampler_seed`` and the number of
 trials finished so far, so a study gives the same parameters whether it ran at once or
 was interrupted and resumed. At the end the best feasible trial is re-evaluated on seeds
-N…N+M−1 and ``best.toml`` (a ``--config`` file), ``study.csv``, ``report.md`` and
-``history.png`` are written.
+N…N+M−1 and ``best.toml`` (a ``--config`` file), ``study.csv``, ``report.md``,
+``history.png`` and ``params.png`` are written.
 """
 
 from __future__ import annotations

@@ -1,5 +1,7 @@
-"""The outputs of a ``stealth tune`` study: ``best.toml``, ``study.csv``, ``report.md`` and
-``history.png`` (the objective of every trial and the best so far).
+"""The outputs of a ``stealth tune`` study: ``best.toml``, ``study.csv``, ``report.md``,
+``history.png`` (the objective of every trial and the best so far) and ``params.png`` (the
+objective against each searched parameter; with a target table also the share of cells
+within tolerance, which the squared objective can rank differently).
 
 ``report.md`` gives the best value on the training seeds and on the held-out seeds, the
 best parameters and Optuna's parameter importances (:mod:`optuna.importance`, its default evaluator; when
@@ -57,6 +59,35 @@ def _history(study: Any, direction: str, path: Path) -> None:
     fig.savefig(path)
 
 
+def _params(study: Any, path: Path) -> None:
+    from matplotlib.figure import Figure
+
+    done = [t for t in study.trials if t.value is not None]
+    keys = sorted({k for t in done for k in t.params})
+    share = any("within_tolerance" in t.user_attrs for t in done)
+    rows = 2 if share else 1
+    fig = Figure(figsize=(max(6.4, 2.6 * len(keys)), 2.8 * rows), dpi=100)
+    for j, key in enumerate(keys):
+        points = [t for t in done if key in t.params]
+        xs = [t.params[key] if not isinstance(t.params[key], str) else str(t.params[key])
+              for t in points]
+        for i in range(rows):
+            ax = fig.add_subplot(rows, max(1, len(keys)), i * len(keys) + j + 1)
+            ys = ([t.value for t in points] if i == 0
+                  else [100 * float(t.user_attrs.get("within_tolerance", math.nan))
+                        for t in points])
+            ax.plot(xs, ys, "o", alpha=0.7)
+            if i == 0:
+                ax.set_yscale("log" if min(ys, default=1) > 0 else "linear")
+            ax.set_xlabel(key.split(".")[-1], fontsize=8)
+            ax.tick_params(labelsize=7)
+            if j == 0:
+                ax.set_ylabel("objective" if i == 0 else "% cells within tol.", fontsize=8)
+    fig.suptitle("stealth tune: each trial against each searched parameter", fontsize=9)
+    fig.tight_layout()
+    fig.savefig(path)
+
+
 def _study_csv(study: Any, path: Path) -> None:
     keys = sorted({k for t in study.trials for k in t.params})
     with path.open("w", newline="", encoding="utf-8") as handle:
@@ -71,9 +102,10 @@ def _study_csv(study: Any, path: Path) -> None:
 
 def write_study_outputs(spec: TuneSpec, study: Any, best: Any, test: dict[str, Any] | None,
                         out: Path) -> None:
-    """Write the four files of the module docstring into ``out``."""
+    """Write the five files of the module docstring into ``out``."""
     _study_csv(study, out / "study.csv")
     _history(study, spec.direction, out / "history.png")
+    _params(study, out / "params.png")
     objective = (f"distance to {spec.target.path.name}" if spec.target is not None
                  else f"{spec.direction} {spec.objective.text if spec.objective else ''}")
     lines = [f"# stealth tune: {spec.path.name}", "",
@@ -109,5 +141,6 @@ def write_study_outputs(spec: TuneSpec, study: Any, best: Any, test: dict[str, A
     else:
         lines += ["| parameter | importance |", "|---|---:|"]
         lines += [f"| `{k}` | {v:.3f} |" for k, v in importances.items()]
-    lines += ["", "## History", "", "![history](history.png)", ""]
+    lines += ["", "## History", "", "![history](history.png)", "",
+              "## Each trial against each parameter", "", "![parameters](params.png)", ""]
     (out / "report.md").write_text("\n".join(lines), encoding="utf-8")

@@ -54,7 +54,7 @@ def test_a_tiny_study_writes_its_outputs_and_is_reproducible(tmp_path: Path) -> 
     path = spec(tmp_path)
     assert tune(path, tmp_path / "a", 3) == 0
     assert tune(path, tmp_path / "b", 3) == 0
-    for name in ("best.toml", "study.csv", "report.md", "history.png"):
+    for name in ("best.toml", "study.csv", "report.md", "history.png", "params.png"):
         assert (tmp_path / "a" / name).stat().st_size > 0, name
     best = read_config_file(tmp_path / "a" / "best.toml")  # a valid --config file
     assert set(best) == {"world.guard_speed", "pf.rho"}

@@ -23,6 +23,7 @@ from pathlib import Path
 import numpy as np
 
 from game.agents import max_agent_speed
+from game.config import Config
 from game.front.camera import Camera
 from game.front.render import DrawOptions, FrameLoop, Renderer, default_window_size, init_pygame, pygame
 from game.scene import GuardDrawing, PlayerDrawing, Scene, SceneBuilder
@@ -184,13 +185,13 @@ class ReplayViewer(FrameLoop):
         self, trace: Trace, level: Level, abstraction: str, *, scenario: str = "capture",
         speed: float = 1.0, lockstep: bool = True, show_mesh: bool = False,
         show_plans: bool = False, size: tuple[int, int] | None = None,
+        config: Config | None = None,
     ) -> None:
-        from game.config import Config
         from navmesh.graph import graph_for
 
         init_pygame()
-        config = Config.defaults()
-        self.graph = graph_for(level, abstraction)
+        config = config if config is not None else Config.defaults()
+        self.graph = graph_for(level, abstraction, float(config["world.agent_radius"]))
         self.view_range = float(config["world.view_range"]) * float(
             config[f"scenario.{scenario}.view_range_scale"])
         self.attack_range = float(config["world.attack_range"])
@@ -323,8 +324,11 @@ class ReplayViewer(FrameLoop):
 # ---------------------------------------------------------------------------- command line
 
 
-def cmd_replay(args: argparse.Namespace) -> int:
-    """``stealth replay TRACE [--level LEVEL]``: see the module docstring and docs/play.md."""
+def cmd_replay(args: argparse.Namespace, config: Config | None = None) -> int:
+    """``stealth replay TRACE [--level LEVEL]``: see the module docstring and docs/play.md.
+
+    ``config``: the configuration the trace was made with (view range, cone, attack range,
+    agent radius); the defaults when not known (a trace file alone does not carry it)."""
     from game.front.play import finish, lockstep_wanted, open_display
     from game.errors import FrontError as UserError
     from navmesh.graph import graph_for
@@ -366,7 +370,7 @@ def cmd_replay(args: argparse.Namespace) -> int:
     viewer = ReplayViewer(
         trace, level, abstraction, scenario=getattr(args, "scenario", "capture"), speed=speed,
         lockstep=lockstep_wanted(args.frames), show_mesh=bool(getattr(args, "mesh", False)),
-        show_plans=bool(getattr(args, "plans", False)),
+        show_plans=bool(getattr(args, "plans", False)), config=config,
     )
     try:
         times = viewer.run(args.frames)
@@ -378,7 +382,9 @@ def cmd_replay(args: argparse.Namespace) -> int:
 
 def replay_trial(spec: TrialSpec, args: argparse.Namespace) -> int:
     """``stealth replay DIR --trial KEY``: re-simulate the trial ``spec`` into a temporary
-    trace and play that back (the caller looks the spec up in the store)."""
+    trace and play that back with the trial's own configuration (its ``[set]`` values and
+    factor levels: a view-range factor draws that range), the caller looks the spec up in
+    the store."""
     from game.trial import run_trial
 
     with tempfile.TemporaryDirectory(prefix="stealth-replay-") as folder:
@@ -387,7 +393,7 @@ def replay_trial(spec: TrialSpec, args: argparse.Namespace) -> int:
             run_trial(spec, trace=handle)
         args.trace, args.level = str(path), spec.level
         args.abstraction, args.scenario = spec.abstraction, spec.scenario
-        return cmd_replay(args)
+        return cmd_replay(args, Config.load(spec.settings))
 
 
 __all__: Sequence[str] = [
