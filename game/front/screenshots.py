@@ -134,7 +134,7 @@ def _replay() -> pygame.Surface:
 
 def _replay_large() -> pygame.Surface:
     """A trace on a 48 × 100 building (too wide for the window) replayed through the camera."""
-    from game.buildings import building_level
+    from navmesh.buildings import building_level
     from game.front.replay import ReplayViewer
     from game.trace import load_trace
     from game.trial import TrialSpec, run_trial
@@ -142,7 +142,7 @@ def _replay_large() -> pygame.Surface:
 
     folder = Path(tempfile.mkdtemp())
     level = folder / "building.json"
-    level.write_text(json.dumps(building_level(48, 100, room=10, guards=8)))
+    level.write_text(json.dumps(building_level(48, 100, guards=8)))
     trace = io.StringIO()
     run_trial(TrialSpec(str(level), "grid", "cheat", "maxmin", "fixed", seed=0,
                         overrides=(("world.duration", 30.0),)), trace=trace)
