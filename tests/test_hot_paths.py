@@ -63,3 +63,57 @@ def test_path_cache_is_bounded_and_skips_signed_zeros(monkeypatch: pytest.Monkey
     size = len(body._paths)
     body.path((0.0, 2.5), (2.5, 2.5))
     assert len(body._paths) == size
+
+
+def _scipy_presence(m, teammates, node: int) -> np.ndarray:
+    """FieldMatrices.presence as it was: one scipy CSR product per call."""
+    block = m.kernel[m.candidates[node]]
+    spreads = np.stack([m.conf_spread(int(t)) for t in teammates])
+    smoothed = np.asarray(block @ spreads.T)
+    return np.ascontiguousarray(smoothed.T).sum(axis=0)
+
+
+@pytest.mark.parametrize("abstraction", ["grid", "partition"])
+def test_presence_equals_the_scipy_product_on_the_bundled_levels(abstraction: str) -> None:
+    """Every other node of every bundled level, with 1 to 4 random teammates, bit for bit."""
+    from ai.fields import FieldMatrices
+    from ai.params import PFParams
+    from navmesh.graph import graph_for
+
+    rng = np.random.default_rng(11)
+    for name in BUNDLED:
+        graph = graph_for(load_level(name), abstraction, 0.3)
+        m = FieldMatrices(graph, PFParams())
+        for node in range(rng.integers(2), graph.n, 2):
+            mates = rng.integers(graph.n, size=int(rng.integers(1, 5)))
+            assert np.array_equal(m.presence(mates, node), _scipy_presence(m, mates, node))
+
+
+def test_presence_equals_the_scipy_product_on_random_inputs() -> None:
+    """Random kernel weights (any row width, empty rows, unsorted columns) and random
+    spread values spanning many magnitudes, so any change of summation order would show."""
+    from ai.fields import FieldMatrices
+    from ai.params import PFParams
+    from navmesh.graph import NodeGraph
+    from scipy import sparse
+
+    rng = np.random.default_rng(5)
+    for trial in range(30):
+        occupancy = rng.random((9, 13)) > 0.25
+        graph = NodeGraph.from_grid(occupancy, 1.0)
+        m = FieldMatrices(graph, PFParams(kernel_radius=int(rng.integers(0, 5))))
+        n = graph.n
+        dense = (rng.random((n, n)) < rng.uniform(0.02, 0.5)) * rng.lognormal(0, 3, (n, n))
+        dense[rng.random(n) < 0.1] = 0.0  # some empty rows
+        csr = sparse.csr_matrix(dense)
+        for r in range(n):  # rows in no particular column order, as a COO build may leave them
+            lo, hi = csr.indptr[r], csr.indptr[r + 1]
+            order = lo + rng.permutation(hi - lo)
+            csr.indices[lo:hi], csr.data[lo:hi] = csr.indices[order], csr.data[order]
+        csr.has_sorted_indices = False
+        m.kernel = csr
+        rows = {t: rng.lognormal(0, 4, n) * (rng.random(n) < 0.8) for t in range(n)}
+        m.conf_spread = rows.__getitem__  # type: ignore[method-assign,assignment]
+        for node in rng.integers(n, size=20):
+            mates = rng.integers(n, size=int(rng.integers(1, 6)))
+            assert np.array_equal(m.presence(mates, int(node)), _scipy_presence(m, mates, int(node)))
