@@ -109,21 +109,23 @@ class FieldMatrices:
         cols, weights = self.kernel_rows(node)
         smoothed = np.empty((len(teammates), len(cols)))  # (t, c): one row per teammate
         for k, t in enumerate(teammates):
-            smoothed[k] = np.cumsum(self.conf_spread(int(t))[cols] * weights, axis=1)[:, -1]
+            smoothed[k] = (self.conf_spread(int(t))[cols] * weights).cumsum(axis=1)[:, -1]
         return smoothed.sum(axis=0)
 
     def kernel_rows(self, node: int) -> tuple[np.ndarray, np.ndarray]:
         """The kernel rows of ``node``'s candidates as (c, w) column indices and weights:
         each row's nonzeros in CSR order, then zero weights (at column 0) up to the widest."""
         def make() -> tuple[np.ndarray, np.ndarray]:
-            block = self.kernel[self.candidates[node]]
-            counts = np.diff(block.indptr)
+            kernel, rows = self.kernel, self.candidates[node]
+            start = kernel.indptr[rows]
+            counts = kernel.indptr[rows + 1] - start
             width = max(int(counts.max(initial=0)), 1)
             filled = np.arange(width) < counts[:, None]
+            at = (start[:, None] + np.arange(width))[filled]  # row after row, in CSR order
             cols = np.zeros(filled.shape, dtype=np.intp)
             weights = np.zeros(filled.shape)
-            cols[filled] = block.indices
-            weights[filled] = block.data
+            cols[filled] = kernel.indices[at]
+            weights[filled] = kernel.data[at]
             return cols, weights
 
         cols, weights = self._rows.get(("K", int(node)), make)
