@@ -100,12 +100,36 @@ class FieldMatrices:
         return total
 
     def presence(self, teammates: Sequence[int] | np.ndarray, node: int) -> np.ndarray:
-        """(c,) ``Σ_t (Kmat @ γ_C^d(t, ·))`` at the candidates of ``node``, over ``teammates``."""
-        candidates = self.candidates[node]
-        block = self._rows.get(("K", int(node)), lambda: (self.kernel[candidates],))[0]
-        spreads = np.stack([self.conf_spread(int(t)) for t in teammates])
-        smoothed = np.asarray(block @ spreads.T)  # (c, t): one kernel row per candidate
-        return np.ascontiguousarray(smoothed.T).sum(axis=0)
+        """(c,) ``Σ_t (Kmat @ γ_C^d(t, ·))`` at the candidates of ``node``, over ``teammates``.
+
+        Each kernel row is gathered from :meth:`kernel_rows` and summed left to right by
+        ``cumsum``, exactly the sequence of scipy's CSR product (``0 + w0·x0 + w1·x1 + …``),
+        without its ~90 µs of overhead per call; teammates are then summed as before.
+        """
+        cols, weights = self.kernel_rows(node)
+        smoothed = np.empty((len(teammates), len(cols)))  # (t, c): one row per teammate
+        for k, t in enumerate(teammates):
+            smoothed[k] = (self.conf_spread(int(t))[cols] * weights).cumsum(axis=1)[:, -1]
+        return smoothed.sum(axis=0)
+
+    def kernel_rows(self, node: int) -> tuple[np.ndarray, np.ndarray]:
+        """The kernel rows of ``node``'s candidates as (c, w) column indices and weights:
+        each row's nonzeros in CSR order, then zero weights (at column 0) up to the widest."""
+        def make() -> tuple[np.ndarray, np.ndarray]:
+            kernel, rows = self.kernel, self.candidates[node]
+            start = kernel.indptr[rows]
+            counts = kernel.indptr[rows + 1] - start
+            width = max(int(counts.max(initial=0)), 1)
+            filled = np.arange(width) < counts[:, None]
+            at = (start[:, None] + np.arange(width))[filled]  # row after row, in CSR order
+            cols = np.zeros(filled.shape, dtype=np.intp)
+            weights = np.zeros(filled.shape)
+            cols[filled] = kernel.indices[at]
+            weights[filled] = kernel.data[at]
+            return cols, weights
+
+        cols, weights = self._rows.get(("K", int(node)), make)
+        return cols, weights
 
 
 _MATRIX_CACHE: weakref.WeakKeyDictionary[NodeGraph, dict[tuple[float, ...], FieldMatrices]] = (

@@ -111,6 +111,9 @@ class Locomotion:
         self.space, self.graph, self.level = space, graph, level
         self.radius, self.dt = radius, dt
         self.body = clearance_for(level, radius)
+        #: node -> its position as Python floats, filled on first use (a numpy row read
+        #: and two float() calls cost more than the rest of a cached plan)
+        self._points: dict[int, tuple[float, float]] = {}
 
     def make_agent(self, node: int, speed: float) -> Agent:
         """A body of the agent radius in the space, standing on ``node``'s position."""
@@ -125,9 +128,12 @@ class Locomotion:
         return agent
 
     def node_point(self, node: int) -> tuple[float, float]:
-        """A node's position as a tuple of floats."""
-        x, y = self.graph.positions[node]
-        return (float(x), float(y))
+        """A node's position as a new tuple of floats (waypoints are told apart by identity)."""
+        point = self._points.get(node)
+        if point is None:
+            x, y = self.graph.positions[node]
+            point = self._points[node] = (float(x), float(y))
+        return (point[0], point[1])
 
     def stand_point(self, node: int) -> tuple[float, float]:
         """Where a body stands on ``node``: its position, or on the partition the nearest

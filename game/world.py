@@ -250,8 +250,10 @@ class World(PlayerActions):
     def _sense(self) -> None:
         """Vision, attack damage, distance and detection metrics for the current positions."""
         ppos = self.player.pos
-        self.seen_by = self.team.detect(
-            self, tuple(i for i, g in enumerate(self.guards) if self.sees(g, ppos)))
+        reach = self.view_range * float(self.view_scale_at[self.player.node])  # as in sees()
+        perceives = self.senses.perceives
+        self.seen_by = self.team.detect(self, tuple(
+            i for i, g in enumerate(self.guards) if g.active and perceives(g.pos, g.heading, ppos, reach)))
         if self.seen_by:
             self.sighting = self.player.node
             if self.m.first_detect_time is None:
