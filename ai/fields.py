@@ -24,6 +24,7 @@ from __future__ import annotations
 
 import weakref
 from collections.abc import Sequence
+from functools import cached_property
 from typing import NamedTuple
 
 import numpy as np
@@ -48,9 +49,10 @@ SPREAD_CACHE_BYTES = 128 * 2**20
 class FieldMatrices:
     """What never changes for one graph and one parameter set; shared by every trial on it.
 
-    Nothing here is n × n: the spreads ``γ^d(s, ·)`` are computed per source node by a BFS
-    cut at :data:`SPREAD_TOLERANCE` and cached (guards and sightings sit on few nodes), the
-    kernel is a sparse radius-δ matrix and the candidate sets are found per node on first use.
+    Nothing here is n × n on a large graph: the spreads ``γ^d(s, ·)`` are computed per
+    source node by a BFS cut at :data:`SPREAD_TOLERANCE` and cached (guards and sightings sit
+    on few nodes), the kernel is a sparse radius-δ matrix and the candidate sets are found per
+    node on first use. Only a graph small enough to be dense keeps its presence table.
     """
 
     def __init__(self, graph: NodeGraph, params: PFParams) -> None:
@@ -70,16 +72,16 @@ class FieldMatrices:
         self._rows = RowCache(SPREAD_CACHE_BYTES)
 
     def _spread(self, which: str, node: int) -> np.ndarray:
+        return self._rows.get((which, node), lambda: (self._spread_row(which, node),))[0]
+
+    def _spread_row(self, which: str, node: int) -> np.ndarray:
+        """(n,) ``γ ** d(node, ·)`` cut at the field's depth (uncached)."""
         gamma, depth = (self.gamma_I, self.depth_I) if which == "I" else (self.gamma_C, self.depth_C)
-
-        def make() -> tuple[np.ndarray]:
-            hops = self.graph.hops_from(node, max_hops=depth)
-            inside = np.flatnonzero(hops < UNREACHABLE_HOPS)
-            row = np.zeros(self.graph.n)
-            row[inside] = gamma ** hops[inside].astype(np.float64)
-            return (row,)
-
-        return self._rows.get((which, node), make)[0]
+        hops = self.graph.hops_from(node, max_hops=depth)
+        inside = np.flatnonzero(hops < UNREACHABLE_HOPS)
+        row = np.zeros(self.graph.n)
+        row[inside] = gamma ** hops[inside].astype(np.float64)
+        return row
 
     def info_spread(self, node: int) -> np.ndarray:
         """(n,) ``γ_I ** d(node, ·)``: the information spread of a sighting at ``node`` (read-only)."""
@@ -106,11 +108,32 @@ class FieldMatrices:
         ``cumsum``, exactly the sequence of scipy's CSR product (``0 + w0·x0 + w1·x1 + …``),
         without its ~90 µs of overhead per call; teammates are then summed as before.
         """
+        table = self.presence_table
+        if table is not None:
+            picked = table[np.ix_(self.candidates[node], np.asarray(teammates, dtype=np.intp))]
+            return np.ascontiguousarray(picked.T).sum(axis=0)
         cols, weights = self.kernel_rows(node)
         smoothed = np.empty((len(teammates), len(cols)))  # (t, c): one row per teammate
         for k, t in enumerate(teammates):
             smoothed[k] = (self.conf_spread(int(t))[cols] * weights).cumsum(axis=1)[:, -1]
         return smoothed.sum(axis=0)
+
+    @cached_property
+    def presence_table(self) -> np.ndarray | None:
+        """(n, n) ``Kmat @ γ_C^d(·, t)`` for a graph small enough to be dense (``graph.dense``:
+        at most DENSE_MAX_NODES nodes, 32 MB at most), else None.
+
+        scipy's CSR × dense product sums each entry in the same sequence as
+        :meth:`presence`'s per-row ``cumsum`` (``0 + w0·x0 + w1·x1 + …``), so either way
+        gives the same bits (tests/test_hot_paths.py); the table makes a decision's
+        presence term one lookup, as round 1's dense matrices did.
+        """
+        if not self.graph.dense:
+            return None
+        spreads = np.stack([self._spread_row("C", t) for t in range(self.graph.n)], axis=1)
+        table = np.asarray(self.kernel @ spreads)
+        table.flags.writeable = False
+        return table
 
     def kernel_rows(self, node: int) -> tuple[np.ndarray, np.ndarray]:
         """The kernel rows of ``node``'s candidates as (c, w) column indices and weights:

@@ -84,9 +84,14 @@ def test_presence_equals_the_scipy_product_on_the_bundled_levels(abstraction: st
     for name in BUNDLED:
         graph = graph_for(load_level(name), abstraction, 0.3)
         m = FieldMatrices(graph, PFParams())
+        rows_only = FieldMatrices(graph, PFParams())
+        rows_only.__dict__["presence_table"] = None  # the large-graph path, per-row sums
+        assert m.presence_table is not None  # bundled graphs are dense: the table path
         for node in range(rng.integers(2), graph.n, 2):
             mates = rng.integers(graph.n, size=int(rng.integers(1, 5)))
-            assert np.array_equal(m.presence(mates, node), _scipy_presence(m, mates, node))
+            expected = _scipy_presence(m, mates, node)
+            assert np.array_equal(m.presence(mates, node), expected)
+            assert np.array_equal(rows_only.presence(mates, node), expected)
 
 
 def test_presence_equals_the_scipy_product_on_random_inputs() -> None:
@@ -114,6 +119,13 @@ def test_presence_equals_the_scipy_product_on_random_inputs() -> None:
         m.kernel = csr
         rows = {t: rng.lognormal(0, 4, n) * (rng.random(n) < 0.8) for t in range(n)}
         m.conf_spread = rows.__getitem__  # type: ignore[method-assign,assignment]
+        m._spread_row = lambda which, t: rows[t]  # type: ignore[method-assign,assignment]
+        rows_only = FieldMatrices(graph, PFParams())
+        rows_only.kernel, rows_only.candidates = csr, m.candidates
+        rows_only.conf_spread = rows.__getitem__  # type: ignore[method-assign,assignment]
+        rows_only.__dict__["presence_table"] = None
         for node in rng.integers(n, size=20):
             mates = rng.integers(n, size=int(rng.integers(1, 6)))
-            assert np.array_equal(m.presence(mates, int(node)), _scipy_presence(m, mates, int(node)))
+            expected = _scipy_presence(m, mates, int(node))
+            assert np.array_equal(m.presence(mates, int(node)), expected)  # the dense table
+            assert np.array_equal(rows_only.presence(mates, int(node)), expected)  # per row
