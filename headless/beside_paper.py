@@ -75,6 +75,16 @@ def beside_paper(directory: Path, literal: Path | None = None) -> str:
     return "\n".join(out) + "\n"
 
 
+def replace_marked(path: Path, begin: str, end: str, text: str) -> bool:
+    """Replace what lies between the ``begin`` and ``end`` markers of a Markdown file with
+    ``text`` (markers kept); False, and the file untouched, when the markers are missing."""
+    doc = path.read_text(encoding="utf-8")
+    pattern = re.compile(re.escape(begin) + r".*?" + re.escape(end), re.S)
+    if not pattern.search(doc):
+        return False
+    path.write_text(pattern.sub(lambda _: f"{begin}\n{text}{end}", doc), encoding="utf-8")
+    return True
+
 def main(argv: Sequence[str] | None = None) -> int:
     parser = argparse.ArgumentParser(prog="python -m headless.beside_paper",
                                      description=__doc__.split("\n\n")[0])
@@ -88,12 +98,9 @@ def main(argv: Sequence[str] | None = None) -> int:
     if args.write is None:
         sys.stdout.write(text)
         return 0
-    doc = args.write.read_text(encoding="utf-8")
-    pattern = re.compile(re.escape(_BEGIN) + r".*?" + re.escape(_END), re.S)
-    if not pattern.search(doc):
+    if not replace_marked(args.write, _BEGIN, _END, text):
         print(f"stealth: error: {args.write}: no {_BEGIN} ... {_END} markers", file=sys.stderr)
         return 2
-    args.write.write_text(pattern.sub(lambda _: f"{_BEGIN}\n{text}{_END}", doc), encoding="utf-8")
     return 0
 
 

@@ -16,14 +16,13 @@ from __future__ import annotations
 
 import argparse
 import math
-import re
 import sys
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from .beside_paper import COLUMNS
+from .beside_paper import COLUMNS, replace_marked
 from .errors import UserError
 from .objective import Cell, Target, aggregate, load_target
 from .store import ResultStore
@@ -233,12 +232,8 @@ def main(argv: Sequence[str] | None = None) -> int:
         if args.write is None:
             sys.stdout.write(text)
             return 0
-        doc = args.write.read_text(encoding="utf-8")
-        pattern = re.compile(re.escape(_BEGIN) + r".*?" + re.escape(_END), re.S)
-        if not pattern.search(doc):
+        if not replace_marked(args.write, _BEGIN, _END, text):
             raise UserError(f"{args.write}: no {_BEGIN} ... {_END} markers")
-        args.write.write_text(pattern.sub(lambda _: f"{_BEGIN}\n{text}{_END}", doc),
-                              encoding="utf-8")
         return 0
     except (UserError, OSError) as error:
         print(f"stealth: error: {error}", file=sys.stderr)
