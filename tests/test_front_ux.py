@@ -180,7 +180,7 @@ def test_replay_has_the_camera_and_minimap_of_the_game(tmp_path: Path) -> None:
     from navmesh.level import load_level
 
     path = tmp_path / "building.json"
-    path.write_text(json.dumps(building_level(120, 160, room=12, guards=4)))
+    path.write_text(json.dumps(building_level(120, 160, guards=4)))
     trace = io.StringIO()
     run_trial(TrialSpec(str(path), "grid", "pf", "maxmin", "capture", seed=0,
                         overrides=(("world.duration", 6.0),)), trace=trace)
