@@ -11,7 +11,6 @@ written by code whose identity differs, and that is said rather than run.
 from __future__ import annotations
 
 import argparse
-import math
 import sys
 from pathlib import Path
 from typing import Any
@@ -19,7 +18,7 @@ from typing import Any
 from game.trial import TrialSpec
 
 from .errors import UserError
-from .store import STORE_NAME, ResultStore, StoredTrial
+from .store import STORE_NAME, ResultStore, StoredTrial, stored_value
 
 __all__ = ["cmd_sim_from", "same_metrics", "stored_spec", "stored_trial"]
 
@@ -57,20 +56,11 @@ def stored_spec(directory: str | Path, key: str) -> TrialSpec:
     return spec_of(stored_trial(directory, key))
 
 
-def _as_stored(value: Any) -> Any:
-    """A metric as the store keeps it (booleans as 0/1, non-finite floats as NULL)."""
-    if isinstance(value, bool):
-        return int(value)
-    if isinstance(value, float) and not math.isfinite(value):
-        return None
-    return value
-
-
 def same_metrics(trial: StoredTrial, metrics: dict[str, Any]) -> list[str]:
     """Names of the metrics whose re-run value differs from the stored one (none: identical)."""
     stored = {**trial.get("extra_metrics", {}), **trial}
     return [name for name, value in metrics.items()
-            if name in stored and _as_stored(stored[name]) != _as_stored(value)]
+            if name in stored and stored_value(stored[name]) != stored_value(value)]
 
 
 def cmd_sim_from(args: argparse.Namespace) -> int:

@@ -38,7 +38,7 @@ from typing import Any
 from game.metrics import Metric, registered_metrics
 
 __all__ = ["IDENTITY", "STORE_NAME", "ResultStore", "StoredTrial", "metric_columns", "pack",
-           "unpack"]
+           "stored_value", "unpack"]
 
 STORE_NAME = "results.sqlite"
 """File name of the store inside a results directory."""
@@ -119,7 +119,8 @@ def _now() -> str:
     return datetime.now(timezone.utc).isoformat(timespec="milliseconds")
 
 
-def _metric_value(value: Any) -> Any:
+def stored_value(value: Any) -> Any:
+    """A metric as the store keeps it (booleans as 0/1, non-finite floats as NULL)."""
     if isinstance(value, bool):
         return int(value)
     if isinstance(value, float) and not math.isfinite(value):
@@ -238,7 +239,7 @@ class ResultStore:
             "root_seed": int(row.get("root_seed", 0)),
             "overrides": json.dumps(dict(row.get("overrides") or {}), sort_keys=True),
             "config_hash": row.get("config_hash"),
-            **{name: _metric_value(metrics.get(name)) for name in self.metric_names},
+            **{name: stored_value(metrics.get(name)) for name in self.metric_names},
             "extra_metrics": json.dumps(extra, sort_keys=True) if extra else None,
             "visits": pack(row.get("visits")),
             "attacks": pack(row.get("attacks")),
