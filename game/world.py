@@ -149,10 +149,16 @@ class World(PlayerActions):
         if forget_detection:
             self.m.first_detect_time = None
 
-    def sees(self, guard: Agent, target: tuple[float, float]) -> bool:
-        """Vision: within range (scaled by the player's zone), inside the cone, clear line."""
-        reach = self.view_range * float(self.view_scale_at[self.player.node])
+    def sees(self, guard: Agent, target: tuple[float, float], reach: float | None = None) -> bool:
+        """Vision: within range (scaled by the player's zone), inside the cone, clear line.
+        ``reach``: that range when the caller has it already (:meth:`view_reach`)."""
+        if reach is None:
+            reach = self.view_reach()
         return guard.active and self.senses.perceives(guard.pos, guard.heading, target, reach)
+
+    def view_reach(self) -> float:
+        """The guards' view range now: the scenario's, scaled by the player's zone."""
+        return self.view_range * float(self.view_scale_at[self.player.node])
 
     @property
     def hp(self) -> float:
@@ -250,10 +256,9 @@ class World(PlayerActions):
     def _sense(self) -> None:
         """Vision, attack damage, distance and detection metrics for the current positions."""
         ppos = self.player.pos
-        reach = self.view_range * float(self.view_scale_at[self.player.node])  # as in sees()
-        perceives = self.senses.perceives
-        self.seen_by = self.team.detect(self, tuple(
-            i for i, g in enumerate(self.guards) if g.active and perceives(g.pos, g.heading, ppos, reach)))
+        reach = self.view_reach()  # once per step, not once per guard
+        self.seen_by = self.team.detect(
+            self, tuple(i for i, g in enumerate(self.guards) if self.sees(g, ppos, reach)))
         if self.seen_by:
             self.sighting = self.player.node
             if self.m.first_detect_time is None:
