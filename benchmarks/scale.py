@@ -173,13 +173,11 @@ def _growth(jobs: list[Job], results: list[dict]) -> list[str]:
 
 def write_between_markers(path: Path, text: str) -> None:
     """Replace what stands between ``<!-- scale:begin -->`` and ``<!-- scale:end -->`` in ``path``."""
+    from headless.markers import replace_marked
+
     begin, end = "<!-- scale:begin -->", "<!-- scale:end -->"
-    doc = path.read_text(encoding="utf-8")
-    if begin not in doc or end not in doc:
+    if not replace_marked(path, begin, end, text + "\n"):
         raise SystemExit(f"scale.py: error: {path} has no {begin} ... {end} markers")
-    head, rest = doc.split(begin, 1)
-    _, tail = rest.split(end, 1)
-    path.write_text(f"{head}{begin}\n{text}\n{end}{tail}", encoding="utf-8")
 
 
 def _seconds(t: dict) -> str:

@@ -12,11 +12,11 @@ from __future__ import annotations
 
 import argparse
 import csv
-import re
 import sys
 from collections.abc import Mapping, Sequence
 from pathlib import Path
 
+from .markers import replace_marked
 from .paper import paper_table3
 
 __all__ = ["COLUMNS", "beside_paper", "main"]
@@ -74,16 +74,6 @@ def beside_paper(directory: Path, literal: Path | None = None) -> str:
             "intervals of", "the mean:", "", "## " + body.strip()]
     return "\n".join(out) + "\n"
 
-
-def replace_marked(path: Path, begin: str, end: str, text: str) -> bool:
-    """Replace what lies between the ``begin`` and ``end`` markers of a Markdown file with
-    ``text`` (markers kept); False, and the file untouched, when the markers are missing."""
-    doc = path.read_text(encoding="utf-8")
-    pattern = re.compile(re.escape(begin) + r".*?" + re.escape(end), re.S)
-    if not pattern.search(doc):
-        return False
-    path.write_text(pattern.sub(lambda _: f"{begin}\n{text}{end}", doc), encoding="utf-8")
-    return True
 
 def main(argv: Sequence[str] | None = None) -> int:
     parser = argparse.ArgumentParser(prog="python -m headless.beside_paper",

@@ -22,8 +22,9 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from .beside_paper import COLUMNS, replace_marked
+from .beside_paper import COLUMNS
 from .errors import UserError
+from .markers import replace_marked
 from .objective import Cell, Target, aggregate, load_target
 from .store import ResultStore
 from .tables import ABSTRACTION_NAMES, GUARD_NAMES, PLAYER_NAMES

@@ -30,6 +30,7 @@ from typing import Any
 import numpy as np
 
 from .errors import UserError
+from .markers import replace_marked
 from .factor_report import numeric_factors
 from .stats import bootstrap_ci
 from .store import STORE_NAME, ResultStore
@@ -296,13 +297,13 @@ def axes_of(keys: tuple[str, str], trials: Sequence[Mapping[str, Any]]) -> Axes:
 def write_between_markers(path: Path, text: str) -> None:
     """Replace what is between the markers of ``path`` with ``text``; without markers,
     append the section heading and the marked text at the end."""
+    body = text.rstrip() + "\n"
+    if path.exists() and replace_marked(path, START, END, body):
+        return
     old = path.read_text(encoding="utf-8") if path.exists() else ""
-    block = f"{START}\n{text.rstrip()}\n{END}"
-    if START in old and END in old and old.index(START) < old.index(END):
-        new = old[:old.index(START)] + block + old[old.index(END) + len(END):]
-    else:
-        new = old.rstrip("\n") + ("\n\n" if old else "") + f"{SECTION}\n\n{block}\n"
-    path.write_text(new, encoding="utf-8")
+    block = f"{START}\n{body}{END}"
+    path.write_text(old.rstrip("\n") + ("\n\n" if old else "") + f"{SECTION}\n\n{block}\n",
+                    encoding="utf-8")
 
 
 def main(argv: Sequence[str] | None = None) -> int:
