@@ -72,11 +72,34 @@ class FieldMatrices:
         self._rows = RowCache(SPREAD_CACHE_BYTES)
 
     def _spread(self, which: str, node: int) -> np.ndarray:
-        return self._rows.get((which, node), lambda: (self._spread_row(which, node),))[0]
+        """(n,) ``γ ** d(node, ·)``, read-only: a cached row on a dense graph, else made
+        from the cached ball (:meth:`_ball`)."""
+        if self.graph.dense:
+            return self._rows.get((which, node), lambda: (self._spread_row(which, node),))[0]
+        inside, values = self._ball(which, node)
+        row = np.zeros(self.graph.n)
+        row[inside] = values
+        row.flags.writeable = False
+        return row
+
+    def _ball(self, which: str, node: int) -> tuple[np.ndarray, np.ndarray]:
+        """The nonzeros of :meth:`_spread` as (sorted nodes, values), cached: on a large
+        graph a spread reaches a few thousand nodes, so rows of n floats would fill the cache
+        with zeros (and a sum of them would add zeros)."""
+        def make() -> tuple[np.ndarray, np.ndarray]:
+            gamma, depth = self._gamma_depth(which)
+            inside, hops = self.graph.hop_ball(node, max_hops=depth)
+            return inside, gamma ** hops.astype(np.float64)
+
+        inside, values = self._rows.get(("ball", which, node), make)
+        return inside, values
+
+    def _gamma_depth(self, which: str) -> tuple[float, int | None]:
+        return (self.gamma_I, self.depth_I) if which == "I" else (self.gamma_C, self.depth_C)
 
     def _spread_row(self, which: str, node: int) -> np.ndarray:
         """(n,) ``γ ** d(node, ·)`` cut at the field's depth (uncached)."""
-        gamma, depth = (self.gamma_I, self.depth_I) if which == "I" else (self.gamma_C, self.depth_C)
+        gamma, depth = self._gamma_depth(which)
         hops = self.graph.hops_from(node, max_hops=depth)
         inside = np.flatnonzero(hops < UNREACHABLE_HOPS)
         row = np.zeros(self.graph.n)
@@ -91,14 +114,41 @@ class FieldMatrices:
         """(n,) ``γ_C ** d(node, ·)``: one guard's confidence deposit from ``node`` (read-only)."""
         return self._spread("C", int(node))
 
+    def conf_spread_at(self, node: int, at: np.ndarray) -> np.ndarray:
+        """``conf_spread(node)[at]`` (any shape of ``at``), without making the (n,) row on a
+        large graph: the values are looked up in the node's ball."""
+        if self.graph.dense:
+            return self.conf_spread(node)[at]
+        inside, values = self._ball("C", int(node))
+        slot = np.minimum(np.searchsorted(inside, at), len(inside) - 1)
+        return np.where(inside[slot] == at, values[slot], 0.0)
+
     def deposit(self, nodes: Sequence[int] | np.ndarray) -> np.ndarray:
-        """(n,) ``Σ_g γ_C ** d(g, ·)`` over ``nodes``, summed in their order (zeros if none)."""
+        """(n,) ``Σ_g γ_C ** d(g, ·)`` over ``nodes``, summed in their order (zeros if none).
+
+        A large graph adds each ball into zeros: outside a ball its row is 0, and x + 0 = x,
+        so the sums are bit for bit those of the (n,) rows.
+        """
         nodes = np.asarray(nodes, dtype=np.intp)
         if not len(nodes):
             return np.zeros(self.graph.n)
+        if not self.graph.dense:
+            total = np.zeros(self.graph.n)
+            for g in nodes:
+                inside, values = self._ball("C", int(g))
+                total[inside] += values
+            return total
         total = self.conf_spread(int(nodes[0])).copy()
         for g in nodes[1:]:
             total += self.conf_spread(int(g))
+        return total
+
+    def deposit_at(self, nodes: Sequence[int] | np.ndarray, at: np.ndarray) -> np.ndarray:
+        """``deposit(nodes)[at]``, summed in the same order, from the balls alone."""
+        nodes = np.asarray(nodes, dtype=np.intp)
+        total = np.zeros(np.shape(at))
+        for g in nodes:
+            total = total + self.conf_spread_at(int(g), at)
         return total
 
     def presence(self, teammates: Sequence[int] | np.ndarray, node: int) -> np.ndarray:
@@ -115,7 +165,7 @@ class FieldMatrices:
         cols, weights = self.kernel_rows(node)
         smoothed = np.empty((len(teammates), len(cols)))  # (t, c): one row per teammate
         for k, t in enumerate(teammates):
-            smoothed[k] = (self.conf_spread(int(t))[cols] * weights).cumsum(axis=1)[:, -1]
+            smoothed[k] = (self.conf_spread_at(int(t), cols) * weights).cumsum(axis=1)[:, -1]
         return smoothed.sum(axis=0)
 
     @cached_property
@@ -268,6 +318,19 @@ def sighting_node(view: WorldView) -> int | None:
 
 
 # ---------------------------------------------------------------------------- the field
+
+
+def composite_potential(
+    weights: tuple[float, float, float],
+    information: np.ndarray,
+    extra: np.ndarray,
+    confidence: np.ndarray,
+    connectivity: np.ndarray,
+) -> np.ndarray:
+    """Eq. 5, ``P = w_I (I + I_extra) + w_C C + w_N N``, elementwise: the whole field or any
+    gathered part of it gives the same bits at the same nodes."""
+    w_I, w_C, w_N = weights  # noqa: N806 — the paper's symbols
+    return w_I * (information + extra) + w_C * confidence + w_N * connectivity
 
 
 def information_layer(values: np.ndarray | Sequence[float], n: int) -> np.ndarray:
@@ -442,14 +505,25 @@ class CompositeField:
     # ------------------------------------------------------------------ potential and kernel
     def _refresh(self) -> None:
         if self._cached_version != self._version:
-            potential = (
-                self.w_I * (self._information + self._extra)
-                + self.w_C * self._confidence
-                + self.w_N * self.matrices.connectivity
-            )
+            potential = self.potential_at(slice(None))
             self._potential = _read_only(potential)
             self._kernel = _read_only(self.matrices.kernel @ potential)
             self._cached_version = self._version
+
+    def potential_at(self, at: np.ndarray | slice) -> np.ndarray:
+        """``potential()[at]``, computed at ``at`` alone (the same operations, so the same bits)."""
+        return composite_potential(self.weights, self._information[at], self._extra[at],
+                                   self._confidence[at], self.matrices.connectivity[at])
+
+    def kernel_at(self, node: int) -> np.ndarray:
+        """``kernel()[candidates(node)]``. A large graph computes just these entries: each
+        candidate's kernel row summed left to right as scipy's CSR product sums it
+        (``0 + w0·P0 + w1·P1 + …``, :meth:`FieldMatrices.presence`), so an AI tick does not
+        pay for a product over every node that a decision reads a few entries of."""
+        if self.graph.dense:
+            return self.kernel()[self.matrices.candidates[node]]
+        cols, weights = self.matrices.kernel_rows(node)
+        return (self.potential_at(cols) * weights).cumsum(axis=1)[:, -1]
 
     def potential(self) -> np.ndarray:
         """P (n,) = w_I (I + I_extra) + w_C C + w_N N (eq. 5); cached until the state changes."""
@@ -486,7 +560,7 @@ class CompositeField:
         if len(candidates) == 0:
             empty = np.zeros(0, dtype=np.intp)
             return Choice(int(node), empty, np.zeros(0), empty)
-        scores = self.kernel()[candidates]
+        scores = self.kernel_at(node)
         scale = self.w_C * self.params.teammate_presence * self.params.C0
         if len(teammates) and scale:
             scores = scores + scale * self.matrices.presence(teammates, node)
@@ -527,6 +601,11 @@ class CompositeField:
             live = self.matrices.deposit(teammates)
         return self.params.teammate_presence * self.params.C0 * live
 
+    def teammate_confidence_at(self, teammates: Sequence[int] | np.ndarray,
+                               at: np.ndarray) -> np.ndarray:
+        """``teammate_confidence(teammates)[at]``, from the teammates' balls alone."""
+        return self.params.teammate_presence * self.params.C0 * self.matrices.deposit_at(teammates, at)
+
     def fields(self) -> dict[str, np.ndarray]:
         """Current I, I_extra, C, N, P, K (read-only arrays), e.g. for the game overlay."""
         self._refresh()
@@ -547,6 +626,7 @@ __all__ = [
     "FieldMatrices",
     "field_matrices",
     "kernel_matrix",
+    "composite_potential",
     "candidate_sets",
     "active_guard_nodes",
     "sighting_node",

@@ -16,7 +16,14 @@ import numpy as np
 
 from navmesh.graph import NodeGraph
 
-from .fields import Choice, CompositeField, active_guard_nodes, information_layer, sighting_node
+from .fields import (
+    Choice,
+    CompositeField,
+    active_guard_nodes,
+    composite_potential,
+    information_layer,
+    sighting_node,
+)
 from .params import PFParams
 from .view import GuardAI, WorldView
 
@@ -31,8 +38,6 @@ class _Decision:
     information: np.ndarray
     extra: np.ndarray
     confidence: np.ndarray
-    potential: np.ndarray
-    kernel: np.ndarray
     weights: tuple[float, float, float]
     teammates: np.ndarray
     recent: tuple[int, ...]
@@ -103,8 +108,6 @@ class PotentialFieldGuards(GuardAI):
             information=field.information,
             extra=field.extra_information,
             confidence=field.confidence,
-            potential=field.potential(),
-            kernel=field.kernel(),
             weights=field.weights,
             teammates=teammates,
             recent=tuple(recent),
@@ -171,8 +174,12 @@ class PotentialFieldGuards(GuardAI):
         if cached is not None and cached[0] is record:  # a pure function of the decision:
             return cached[1]  # the game asks every frame, the decision changes about 1/s
         w_I, w_C, w_N = record.weights  # noqa: N806 — the paper's symbols
-        connectivity = self.field.connectivity
-        live = self.field.teammate_confidence(record.teammates)
+        at = np.asarray(record.choice.candidates, dtype=np.intp)
+        connectivity = self.field.connectivity[at]
+        live = self.field.teammate_confidence_at(record.teammates, at)
+        # P as the field computed it for this decision, at the candidates only (eq. 5)
+        potential = composite_potential(record.weights, record.information[at],
+                                        record.extra[at], record.confidence[at], connectivity)
         revisit_unit = w_C * self.config.revisit_penalty * self.config.C0
         candidates = [
             {
@@ -180,13 +187,13 @@ class PotentialFieldGuards(GuardAI):
                 "I": float(record.information[c]),
                 "I_extra": float(record.extra[c]),
                 "C": float(record.confidence[c]),
-                "C_live": float(live[c]),
-                "N": float(connectivity[c]),
-                "P": float(record.potential[c] + w_C * live[c]),
+                "C_live": float(live[j]),
+                "N": float(connectivity[j]),
+                "P": float(potential[j] + w_C * live[j]),
                 "revisit": float(revisit_unit if int(c) in record.recent else 0.0),
-                "K": float(k),
+                "K": float(record.choice.scores[j]),
             }
-            for c, k in zip(record.choice.candidates, record.choice.scores, strict=True)
+            for j, c in enumerate(record.choice.candidates)
         ]
         if record.personal is not None:
             for entry, c in zip(candidates, record.choice.candidates, strict=True):

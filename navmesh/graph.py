@@ -19,7 +19,7 @@ from __future__ import annotations
 from collections import OrderedDict
 from collections.abc import Callable, Hashable, Iterator, Sequence
 from dataclasses import dataclass, field
-from functools import lru_cache
+from functools import cached_property, lru_cache
 from typing import TYPE_CHECKING, Any, Literal
 
 import numpy as np
@@ -312,9 +312,30 @@ class NodeGraph:
         limit = np.inf if max_hops is None else float(max_hops)
         (row,) = self._rows.get(
             ("hops", s, max_hops),
-            lambda: (_as_hops(dijkstra(self.adjacency, indices=s, unweighted=True, limit=limit)),),
+            lambda: (_as_hops(dijkstra(self._unit_adjacency, indices=s, limit=limit)),),
         )
         return row
+
+    def hop_ball(self, src: int, max_hops: int | None = None) -> tuple[np.ndarray, np.ndarray]:
+        """The nodes within ``max_hops`` of ``src`` (sorted) and their hop distances (int32):
+        the finite part of :meth:`hops_from`, without keeping an (n,) row on a large graph."""
+        s = int(src)
+        if self.dense:
+            row = self._hops[s]
+            inside = np.flatnonzero(row < UNREACHABLE_HOPS if max_hops is None else row <= max_hops)
+            return inside, row[inside]
+        limit = np.inf if max_hops is None else float(max_hops)
+        found = dijkstra(self._unit_adjacency, indices=s, limit=limit)
+        inside = np.flatnonzero(np.isfinite(found))
+        return inside, found[inside].astype(np.int32)
+
+    @cached_property
+    def _unit_adjacency(self) -> csr_matrix:
+        """The adjacency with every edge 1: a Dijkstra search on it counts hops (what
+        ``unweighted=True`` does, without copying the weights on every search)."""
+        unit = self.adjacency.copy()
+        unit.data = np.ones_like(unit.data)
+        return unit
 
     def hops_between(self, a: int | np.ndarray | Sequence[int], b: int | np.ndarray | Sequence[int]) -> np.ndarray | int:
         """Hop distance of each pair (a[i], b[i]) (broadcast like numpy indexing)."""

@@ -15,7 +15,9 @@ import pytest
 from scipy.sparse.csgraph import shortest_path
 from scipy.spatial import Delaunay
 
-from ai.fields import FieldMatrices, candidate_sets
+from ai.fields import CompositeField, FieldMatrices, candidate_sets
+from ai.pf import PotentialFieldGuards
+from ai.view import WorldView
 from ai.params import PFParams
 from navmesh.graph import (
     UNREACHABLE_HOPS,
@@ -116,6 +118,40 @@ def test_nearest_distances_equal_the_min_over_rows(pair: tuple[NodeGraph, NodeGr
             near = sparse.nearest_dist(srcs, around=target, reach=reach)
             close = dense.dist_from(target) <= 3 * dense.max_edge_length
             assert np.array_equal(near[close], rows[close])
+
+
+def test_decisions_on_a_searched_graph_equal_the_dense_ones(pair: tuple[NodeGraph, NodeGraph]) -> None:
+    """A large graph's field reads K at a decision's candidates alone (kernel_at) and the
+    spreads from their balls: the scores, winners and explanations stay bit for bit."""
+    dense, sparse = pair
+    rng = np.random.default_rng(9)
+    fields = [CompositeField(g) for g in (dense, sparse)]
+    for step in range(3):
+        guards = rng.choice(dense.n, size=3)
+        sighting = int(rng.integers(dense.n)) if step != 1 else None
+        extra = -rng.random(dense.n) * (rng.random(dense.n) < 0.1)
+        for f in fields:
+            f.tick(1.0, guards, sighting)
+            f.extra_information = extra
+        assert np.array_equal(fields[0].kernel(), fields[1].kernel())
+        for node in range(0, dense.n, max(1, dense.n // 25)):
+            mates = rng.choice(dense.n, size=2)
+            a, b = (f.select(node, np.random.default_rng(node), mates) for f in fields)
+            assert np.array_equal(a.scores, b.scores) and a.winner == b.winner
+            assert np.array_equal(fields[1].kernel_at(node),
+                                  fields[1].kernel()[fields[1].candidates(node)])
+    answers = []
+    for graph in (dense, sparse):
+        guards = PotentialFieldGuards()
+        guards.reset(graph, np.random.default_rng(0), 3)
+        nodes = np.array([0, graph.n // 2, graph.n - 1])
+        view = WorldView(t=0.0, graph=graph, guard_nodes=nodes,
+                         guard_positions=graph.positions[nodes], guard_headings=np.zeros(3),
+                         player_node=graph.n // 3, player_pos=graph.positions[graph.n // 3],
+                         sighting=graph.n // 3)
+        guards.tick(view, 1.0)
+        answers.append([(guards.decide(i, view), guards.explain(i)) for i in range(3)])
+    assert answers[0] == answers[1]
 
 
 def test_hop_balls_match_the_dense_matrix(pair: tuple[NodeGraph, NodeGraph]) -> None:

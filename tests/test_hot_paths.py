@@ -123,6 +123,7 @@ def test_presence_equals_the_scipy_product_on_random_inputs() -> None:
         rows_only = FieldMatrices(graph, PFParams())
         rows_only.kernel, rows_only.candidates = csr, m.candidates
         rows_only.conf_spread = rows.__getitem__  # type: ignore[method-assign,assignment]
+        rows_only.conf_spread_at = lambda t, at: rows[t][at]  # type: ignore[method-assign,assignment]
         rows_only.__dict__["presence_table"] = None
         for node in rng.integers(n, size=20):
             mates = rng.integers(n, size=int(rng.integers(1, 6)))
