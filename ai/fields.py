@@ -22,8 +22,10 @@ read-only, so references handed out by :meth:`CompositeField.fields` or kept for
 
 from __future__ import annotations
 
+import time
 import weakref
-from collections.abc import Sequence
+from collections import deque
+from collections.abc import Generator, Sequence
 from functools import cached_property
 from typing import NamedTuple
 
@@ -70,6 +72,42 @@ class FieldMatrices:
         #: per node, the nodes a guard standing there may choose (SPEC §3.5)
         self.candidates = CandidateSets(graph, params.r_edge_factor)
         self._rows = RowCache(SPREAD_CACHE_BYTES)
+        #: large graph: nodes whose confidence ball will soon be read (guards' next nodes),
+        #: and the one being searched ahead (:meth:`warm`)
+        self._ahead: deque[int] = deque()
+        self._warming: tuple[int, Generator[None, None, tuple[np.ndarray, np.ndarray]]] | None = None
+        if not graph.dense:
+            graph.hop_ball(0, 0)  # the searches' neighbour table, built now rather than mid-game
+
+    def anticipate(self, node: int) -> None:
+        """``node``'s confidence ball will be needed soon (a guard heads there): on a large
+        graph, queue it for :meth:`warm`."""
+        if not self.graph.dense:
+            self._ahead.append(int(node))
+
+    def warm(self, budget: float) -> None:
+        """Search the queued balls not yet kept for about ``budget`` seconds, a ring at a
+        time, at least one (a search left unfinished goes on at the next call): work the game does in a
+        frame's spare time, so the next tick and decisions find the balls. Values never
+        depend on it."""
+        deadline = time.perf_counter() + budget
+        first = True  # at least one ring per call, whatever the budget
+        while first or time.perf_counter() < deadline:
+            first = False
+            if self._warming is None:
+                while self._ahead and ("ball", "C", self._ahead[0]) in self._rows:
+                    self._ahead.popleft()
+                if not self._ahead:
+                    return
+                node = self._ahead.popleft()
+                self._warming = (node, self.graph.hop_ball_search(node, self.depth_C))
+            node, search = self._warming
+            try:
+                next(search)
+            except StopIteration as done:
+                self._warming = None
+                inside, hops = done.value
+                self._rows.get(("ball", "C", node), lambda: self._ball_values("C", inside, hops))
 
     def _spread(self, which: str, node: int) -> np.ndarray:
         """(n,) ``γ ** d(node, ·)``, read-only: a cached row on a dense graph, else made
@@ -87,12 +125,18 @@ class FieldMatrices:
         graph a spread reaches a few thousand nodes, so rows of n floats would fill the cache
         with zeros (and a sum of them would add zeros)."""
         def make() -> tuple[np.ndarray, np.ndarray]:
-            gamma, depth = self._gamma_depth(which)
-            inside, hops = self.graph.hop_ball(node, max_hops=depth)
-            return inside, gamma ** hops.astype(np.float64)
+            warming = self._warming
+            if warming is not None and which == "C" and warming[0] == node:
+                self._warming = None  # being searched ahead: finish that search
+                return self._ball_values(which, *_drain(warming[1]))
+            return self._ball_values(which, *self.graph.hop_ball(node, self._gamma_depth(which)[1]))
 
         inside, values = self._rows.get(("ball", which, node), make)
         return inside, values
+
+    def _ball_values(self, which: str, inside: np.ndarray, hops: np.ndarray,
+                     ) -> tuple[np.ndarray, np.ndarray]:
+        return inside, self._gamma_depth(which)[0] ** hops.astype(np.float64)
 
     def _gamma_depth(self, which: str) -> tuple[float, int | None]:
         return (self.gamma_I, self.depth_I) if which == "I" else (self.gamma_C, self.depth_C)
@@ -294,6 +338,17 @@ def candidate_sets(graph: NodeGraph, r_edge_factor: float) -> tuple[np.ndarray, 
     return tuple(sets[s] for s in range(graph.n))
 
 
+def _drain(search: Generator[None, None, tuple[np.ndarray, np.ndarray]],
+           ) -> tuple[np.ndarray, np.ndarray]:
+    """Run a paused search to its end: its result."""
+    while True:
+        try:
+            next(search)
+        except StopIteration as done:
+            found: tuple[np.ndarray, np.ndarray] = done.value
+            return found
+
+
 def _read_only(array: np.ndarray) -> np.ndarray:
     array.flags.writeable = False
     return array
@@ -348,6 +403,30 @@ class Choice(NamedTuple):
     candidates: np.ndarray
     scores: np.ndarray
     tied: np.ndarray
+
+
+class FieldSnapshot(NamedTuple):
+    """A field's state at one moment; calling it computes that moment's :meth:`CompositeField.fields`
+    (the same P and K bits), touching nothing of the live field."""
+
+    weights: tuple[float, float, float]
+    information: np.ndarray
+    extra: np.ndarray
+    confidence: np.ndarray
+    connectivity: np.ndarray
+    kernel_matrix: sparse.csr_matrix
+
+    @property
+    def identity(self) -> tuple[int, int, int, tuple[float, float, float]]:
+        """Changes whenever the fields do (the state arrays are replaced, never modified)."""
+        return id(self.information), id(self.extra), id(self.confidence), self.weights
+
+    def __call__(self) -> dict[str, np.ndarray]:
+        potential = _read_only(composite_potential(self.weights, self.information, self.extra,
+                                                   self.confidence, self.connectivity))
+        return {"I": self.information, "I_extra": self.extra, "C": self.confidence,
+                "N": self.connectivity, "P": potential,
+                "K": _read_only(self.kernel_matrix @ potential)}
 
 
 class CompositeField:
@@ -606,6 +685,12 @@ class CompositeField:
         """``teammate_confidence(teammates)[at]``, from the teammates' balls alone."""
         return self.params.teammate_presence * self.params.C0 * self.matrices.deposit_at(teammates, at)
 
+    def snapshot(self) -> FieldSnapshot:
+        """The state now, to compute :meth:`fields` from later (on any thread): references to
+        the immutable arrays and the weights, nothing computed yet."""
+        return FieldSnapshot(self.weights, self._information, self._extra, self._confidence,
+                             self.matrices.connectivity, self.matrices.kernel)
+
     def fields(self) -> dict[str, np.ndarray]:
         """Current I, I_extra, C, N, P, K (read-only arrays), e.g. for the game overlay."""
         self._refresh()
@@ -622,6 +707,7 @@ class CompositeField:
 __all__ = [
     "CompositeField",
     "CandidateSets",
+    "FieldSnapshot",
     "Choice",
     "FieldMatrices",
     "field_matrices",

@@ -8,7 +8,7 @@ candidate set; ``explain`` says why, in plain JSON-able types.
 from __future__ import annotations
 
 from collections import deque
-from collections.abc import Mapping
+from collections.abc import Callable, Hashable, Mapping
 from dataclasses import dataclass
 from typing import Any
 
@@ -101,6 +101,7 @@ class PotentialFieldGuards(GuardAI):
         own = self._personal[i] if 0 <= i < len(self._personal) else None
         personal = None if own is None else own[0]
         choice = field.select(node, self.rng, teammates, recent, personal)
+        field.matrices.anticipate(choice.winner)  # the guard's next node: its deposit ahead
         self._last[i] = _Decision(
             t=float(view.t),
             node=node,
@@ -219,6 +220,15 @@ class PotentialFieldGuards(GuardAI):
     def fields(self) -> dict[str, np.ndarray]:
         """Current I, I_extra, C, N, P, K arrays (read-only), for the game overlay."""
         return self.field.fields()
+
+    def prepare(self, budget: float) -> None:
+        """The guards' next nodes' spreads ahead, for about ``budget`` s (:meth:`FieldMatrices.warm`)."""
+        self.field.matrices.warm(budget)
+
+    def fields_later(self) -> tuple[Hashable, Callable[[], dict[str, np.ndarray]]]:
+        """The field's state now (:meth:`CompositeField.snapshot`): nothing computed until called."""
+        snapshot = self.field.snapshot()
+        return snapshot.identity, snapshot.__call__
 
     def state_name(self, i: int) -> str:
         """``alert`` while a recent detection keeps w_I above its base, else ``patrol``."""

@@ -10,7 +10,7 @@ never touches pymunk and never learns which abstraction it runs on.
 from __future__ import annotations
 
 from abc import ABC, abstractmethod
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Hashable, Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -150,6 +150,19 @@ class GuardAI(ABC):
         Empty by default: a mode without fields draws no overlay.
         """
         return {}
+
+    def prepare(self, budget: float) -> None:
+        """Spare time of about ``budget`` seconds (the game calls it after a quick frame): a
+        mode may work ahead here, such as cache entries a coming decision will read; never
+        anything that changes a result. Nothing by default."""
+
+    def fields_later(self) -> tuple[Hashable, Callable[[], dict[str, np.ndarray]]]:
+        """:meth:`fields` as they are now, to compute later and on another thread: an
+        identity that changes when they change, and the function that computes them (the
+        game builds a large level's overlay off the frame). By default they are computed
+        now, and the identity is that of the arrays."""
+        fields = self.fields()
+        return tuple(id(a) for a in fields.values()), lambda: fields
 
     def hears_stimuli(self) -> bool:
         """Whether the stimuli's information layer reaches this mode (default: no).

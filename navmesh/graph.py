@@ -17,7 +17,7 @@ takes (tests/test_graph_queries.py checks it).
 from __future__ import annotations
 
 from collections import OrderedDict
-from collections.abc import Callable, Hashable, Iterator, Sequence
+from collections.abc import Callable, Generator, Hashable, Iterator, Sequence
 from dataclasses import dataclass, field
 from functools import cached_property, lru_cache
 from typing import TYPE_CHECKING, Any, Literal
@@ -109,6 +109,9 @@ class RowCache:
     def __init__(self, max_bytes: int) -> None:
         self.max_bytes, self.bytes = max_bytes, 0
         self._rows: OrderedDict[Hashable, tuple[np.ndarray, ...]] = OrderedDict()
+
+    def __contains__(self, key: Hashable) -> bool:
+        return key in self._rows
 
     def get(self, key: Hashable, make: Callable[[], tuple[np.ndarray, ...]]) -> tuple[np.ndarray, ...]:
         rows = self._rows.get(key)
@@ -324,10 +327,42 @@ class NodeGraph:
             row = self._hops[s]
             inside = np.flatnonzero(row < UNREACHABLE_HOPS if max_hops is None else row <= max_hops)
             return inside, row[inside]
-        limit = np.inf if max_hops is None else float(max_hops)
-        found = dijkstra(self._unit_adjacency, indices=s, limit=limit)
-        inside = np.flatnonzero(np.isfinite(found))
-        return inside, found[inside].astype(np.int32)
+        search = self.hop_ball_search(s, max_hops)
+        while True:
+            try:
+                next(search)
+            except StopIteration as done:
+                found: tuple[np.ndarray, np.ndarray] = done.value
+                return found
+
+    def hop_ball_search(self, src: int, max_hops: int | None = None,
+                        ) -> Generator[None, None, tuple[np.ndarray, np.ndarray]]:
+        """:meth:`hop_ball` as a breadth-first search that pauses (yields) after each ring,
+        so a caller with a time budget can spread one ball over several frames; it returns
+        (``StopIteration.value``) the same sorted nodes and hops. A ring is one gather from
+        the padded neighbour table and a few vector operations, without the (n,) setup of a
+        scipy search; hop counts are exact integers either way."""
+        table, visited = self._neighbour_table, np.zeros(self.n + 1, dtype=bool)
+        visited[self.n] = True  # the padding's node: never entered
+        slot = np.empty(self.n + 1, dtype=np.intp)  # dedup without sorting: last write wins
+        hop = np.empty(self.n + 1, dtype=np.int32)
+        ring = np.array([int(src)], dtype=np.intp)
+        visited[ring] = True
+        hop[ring] = 0
+        rings = 1
+        depth = self.n if max_hops is None else int(max_hops)
+        while len(ring) and rings <= depth:
+            reached = table[ring].ravel()
+            reached = reached[~visited[reached]]
+            order = np.arange(len(reached))
+            slot[reached] = order
+            ring = reached[slot[reached] == order]
+            visited[ring] = True
+            hop[ring] = rings
+            rings += 1
+            yield
+        nodes = np.flatnonzero(visited[: self.n])
+        return nodes, hop[nodes]
 
     @cached_property
     def _unit_adjacency(self) -> csr_matrix:
@@ -336,6 +371,16 @@ class NodeGraph:
         unit = self.adjacency.copy()
         unit.data = np.ones_like(unit.data)
         return unit
+
+    @cached_property
+    def _neighbour_table(self) -> np.ndarray:
+        """(n, max degree) neighbours of every node, padded with the node index n."""
+        nb = self.neighbors
+        counts = np.diff(nb.indptr)  # type: ignore[attr-defined]
+        table = np.full((self.n, max(self.max_degree, 1)), self.n, dtype=np.intp)
+        slots = np.arange(table.shape[1]) < counts[:, None]
+        table[slots] = nb.indices  # type: ignore[attr-defined]
+        return table
 
     def hops_between(self, a: int | np.ndarray | Sequence[int], b: int | np.ndarray | Sequence[int]) -> np.ndarray | int:
         """Hop distance of each pair (a[i], b[i]) (broadcast like numpy indexing)."""
