@@ -27,6 +27,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 if TYPE_CHECKING:
+    from .distance_worker import DistanceWorker
     from .world import World
 
 __all__ = ["AGGREGATES", "Counters", "Metric", "TableColumn", "register_metric",
@@ -57,10 +58,25 @@ class Counters:
     #: second, steps 20 times, so the lookup is cached)
     _dist_key: tuple[int, ...] = ()
     _dist_now: float | None = None
+    #: set (the game on a large level): the searches run there, and the samples wait in
+    #: ``_dist_runs`` as [search, key, steps] until :meth:`settle` sums them
+    distance_worker: DistanceWorker | None = None
+    _dist_runs: list[list[Any]] = field(default_factory=list)
 
     def sample_distance(self, graph: Any, player_node: int, guard_nodes: list[int]) -> None:
         """One physics step's shortest-path distance from the player to the nearest guard."""
         key = (player_node, *guard_nodes)
+        if self.distance_worker is not None:
+            if not guard_nodes:
+                self._dist_key = key
+                return
+            if key != self._dist_key or not self._dist_runs:
+                self._dist_key = key
+                search = self.distance_worker.submit(tuple(guard_nodes), player_node)
+                self._dist_runs.append([search, key, 0])
+            self._dist_runs[-1][2] += 1
+            self.dist_samples += 1
+            return
         if key != self._dist_key:
             self._dist_key = key
             self._dist_now = (graph.nearest_dist_to(guard_nodes, player_node)
@@ -68,6 +84,25 @@ class Counters:
         if self._dist_now is not None:
             self.dist_sum += self._dist_now
             self.dist_samples += 1
+
+    def settle(self) -> None:
+        """Add the worker's distances to ``dist_sum`` — one addition per step, in step
+        order, as :meth:`sample_distance` adds them without a worker (the same bits)."""
+        worker = self.distance_worker
+        if worker is None or not self._dist_runs:
+            return
+        runs, self._dist_runs = self._dist_runs, []
+        for search, key, steps in runs:
+            value = worker.value(search, tuple(key[1:]), key[0])
+            for _ in range(steps):
+                self.dist_sum += value
+        # the next sample starts a new run even on the same key (its search is gone)
+        self._dist_key = ()
+
+    def mean_distance(self) -> float | None:
+        """The mean of the distance samples (None: no guard was ever in play)."""
+        self.settle()
+        return self.dist_sum / self.dist_samples if self.dist_samples else None
 
     def count_capture(self, t: float) -> None:
         """The player lost all HP at time ``t``."""
@@ -182,7 +217,7 @@ _CORE: tuple[Metric, ...] = (
            definition="fraction of walkable nodes (cells or triangles) any guard entered, in "
            "[0, 1]"),
     Metric("avg_guard_player_dist",
-           lambda w: w.m.dist_sum / w.m.dist_samples if w.m.dist_samples else None,
+           lambda w: w.m.mean_distance(),
            column="AvgGuardPlayerDist", title="AvgGuard–PlayerDist", unit="world units",
            definition="mean over physics steps of the shortest-path distance (world units) "
            "from the player's node to the closest guard's node"),

@@ -28,7 +28,8 @@ from __future__ import annotations
 
 import functools
 import math
-from collections.abc import Callable, Mapping, Sequence
+from collections.abc import Callable, Hashable, Mapping, Sequence
+from concurrent.futures import Future, ThreadPoolExecutor
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
@@ -39,6 +40,8 @@ from shapely.geometry.base import BaseGeometry
 
 from navmesh.graph import NodeGraph
 from navmesh.level import Level
+
+from .background import lowest_priority
 
 if TYPE_CHECKING:
     from .world import World
@@ -320,12 +323,17 @@ class SceneBuilder:
 
     Field layers are cached by the identity of the source arrays (the AI hands out
     immutable snapshots that change once per AI tick), so a renderer can cache its
-    colour-mapped image by the identity of the layer.
+    colour-mapped image by the identity of the layer. With ``background_fields`` a new
+    layer is computed on a worker thread from the AI's :meth:`~ai.view.GuardAI.fields_later`
+    (numpy and scipy release the GIL) while frames keep the previous one: on a level of
+    10^6 cells the whole-level P, K and normalisation of one tick take tens of ms, which
+    the game spends beside the frames rather than in one of them. Only what is drawn
+    lags, by the few frames the worker takes; the simulation does not wait for it.
     """
 
     def __init__(
         self, level: Level, graph: NodeGraph, *, view_range: float, fov_deg: float,
-        rays_per_radian: float = RAYS_PER_RADIAN,
+        rays_per_radian: float = RAYS_PER_RADIAN, background_fields: bool = False,
     ) -> None:
         self.level, self.graph = level, graph
         self.static = StaticScene.from_level(level, graph)
@@ -339,6 +347,11 @@ class SceneBuilder:
         self._corners = corners
         self._buckets = _WallBuckets(walls, corners) if len(walls) > _BUCKET_MIN_WALLS else None
         self._layers: dict[str, tuple[tuple[int, ...], tuple[Any, ...], FieldLayer]] = {}
+        self._background = (ThreadPoolExecutor(1, "field-layer", initializer=lowest_priority)
+                            if background_fields else None)
+        #: background: per overlay, the identity and (layer, note) last shown
+        self._shown: dict[str, tuple[Hashable, tuple[FieldLayer | None, str]]] = {}
+        self._pending: tuple[str, Hashable, Future[tuple[FieldLayer | None, str]]] | None = None
 
     # ------------------------------------------------------------------ cones
     def cone(self, pos: Point, heading: float, reach: float) -> np.ndarray:
@@ -372,6 +385,30 @@ class SceneBuilder:
         self._layers[key] = (ids, sources, layer)  # keep the sources alive: ids stay unique
         return layer
 
+    def _layer_and_note(self, overlay: str, fields: Mapping[str, np.ndarray],
+                        mode: str) -> tuple[FieldLayer | None, str]:
+        """The layer of ``overlay`` from ``fields``, or None and the reason why not."""
+        if not fields:
+            return None, f"no fields in mode {mode}"
+        layer = self.field_layer(overlay, fields)
+        return layer, "" if layer is not None else f"field {overlay} not available"
+
+    def _layer_later(self, overlay: str, guard_ai: Any) -> tuple[FieldLayer | None, str]:
+        """The newest finished layer of ``overlay``; a newer state is handed to the worker
+        (one job at a time: a state that changes meanwhile is taken when it is free)."""
+        assert self._background is not None
+        identity, compute = guard_ai.fields_later()
+        pending = self._pending
+        if pending is not None and pending[2].done():
+            self._shown[pending[0]] = (pending[1], pending[2].result())
+            self._pending = pending = None
+        shown = self._shown.get(overlay)
+        if (shown is None or shown[0] != identity) and pending is None:
+            mode = guard_ai.mode
+            job = self._background.submit(lambda: self._layer_and_note(overlay, compute(), mode))
+            self._pending = (overlay, identity, job)
+        return shown[1] if shown is not None else (None, "")
+
     # ------------------------------------------------------------------ from a world
     def from_world(self, world: World, overlay: str = "none", plans: bool = False) -> Scene:
         """The frame of ``world`` now, with the ``overlay`` field and optionally the plans."""
@@ -399,14 +436,10 @@ class SceneBuilder:
                 state=str(guard_ai.state_name(i)) if g.active else "down", cone=cone, **extra,
             ))
         field_layer, note = None, ""
-        if overlay != "none":
-            fields = guard_ai.fields()
-            if not fields:
-                note = f"no fields in mode {guard_ai.mode}"
-            else:
-                field_layer = self.field_layer(overlay, fields)
-                if field_layer is None:
-                    note = f"field {overlay} not available"
+        if overlay != "none" and self._background is not None:
+            field_layer, note = self._layer_later(overlay, guard_ai)
+        elif overlay != "none":
+            field_layer, note = self._layer_and_note(overlay, guard_ai.fields(), guard_ai.mode)
         if world.done:
             status = "captured" if (world.end_on_capture and world.m.captures) else "survived"
         else:

@@ -23,8 +23,10 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from typing import Any
 
+from game.distance_worker import DistanceWorker
 from game.front.camera import Camera
 from game.front.effects import NoiseRings, draw_rain
+from game.front.layers import COMPOSE_STRIPES
 from game.front.palette import BAD, GOOD, WARN
 from game.front.render import (
     DrawOptions,
@@ -131,6 +133,7 @@ class PlayGame(FrameLoop):
         self.clock = pygame.time.Clock()
         self.sessions: list[dict[str, Any]] = []
         self._size, self._screen = size, screen
+        self._distances: DistanceWorker | None = None
         self._load(settings.level, settings.guards)
         _freeze_heap()
 
@@ -142,6 +145,8 @@ class PlayGame(FrameLoop):
         self.builder = SceneBuilder(
             self.level, self.world.graph, view_range=self.world.view_range,
             fov_deg=float(self.config["world.fov_deg"]),
+            # a large level's whole-field overlay is computed beside the frames
+            background_fields=not self.world.graph.dense,
         )
         if self._screen is None:
             pygame.display.set_caption(f"Stealthfield — {self.level.name}")
@@ -149,7 +154,10 @@ class PlayGame(FrameLoop):
             self._screen = pygame.display.set_mode(size, pygame.RESIZABLE)
         self.screen = self._screen
         self.camera = Camera()
-        self.renderer = Renderer(self.builder.static, self.screen.get_size(), self.camera)
+        # a large level's new field values are composed over a few frames (layers.py)
+        stripes = 1 if self.world.graph.dense else COMPOSE_STRIPES
+        self.renderer = Renderer(self.builder.static, self.screen.get_size(), self.camera,
+                                 compose_stripes=stripes)
         self.scene: Scene | None = None
 
     # ------------------------------------------------------------------ world
@@ -163,6 +171,11 @@ class PlayGame(FrameLoop):
             seed=self.settings.seed, stimuli=self.settings.stimuli,
         )
         world = make_world(spec, self.config, interactive=True)
+        if not world.graph.dense:  # a large level: the distance metric's searches beside the frames
+            if self._distances is None or self._distances.graph is not world.graph:
+                self._close_distances()
+                self._distances = DistanceWorker(world.graph)
+            world.m.distance_worker = self._distances
         if self.autopilot is None:
             world.player_input = (0.0, 0.0)  # the keyboard drives; the policy never runs
         self.goal = Objectives.of(world.level)
@@ -447,7 +460,14 @@ class PlayGame(FrameLoop):
         return scene
 
     def frame(self, elapsed: float = 0.0) -> None:
-        """One frame: events, world update, drawing, display flip."""
+        """One frame: events, world update, drawing, display flip, then work ahead.
+
+        A frame that took less than :data:`WORK_AHEAD_UNTIL` lets the guard AI use the rest
+        of it (:meth:`~ai.view.GuardAI.prepare`): on a large level the spreads of the nodes
+        the guards head for are searched there, a ring at a time, instead of inside the
+        next tick or decision. It changes no result, only when the work is done.
+        """
+        start = time.perf_counter()
         for event in pygame.event.get():
             self.handle(event)
         if not self.running:
@@ -455,12 +475,25 @@ class PlayGame(FrameLoop):
         self.update(elapsed)
         self.draw()
         pygame.display.flip()
+        spare = WORK_AHEAD_UNTIL - (time.perf_counter() - start)
+        if spare > 0 and not self.idle():
+            self.world.guard_ai.prepare(spare)
 
     def close(self) -> None:
         """Store the session still open (if recording) and give the frozen heap back."""
         self._close_session("quit")
+        self._close_distances()
         gc.unfreeze()
 
+    def _close_distances(self) -> None:
+        if self._distances is not None:
+            self._distances.close()
+            self._distances = None
+
+
+
+#: Seconds into a frame up to which the guard AI may work ahead (half a 60 Hz frame).
+WORK_AHEAD_UNTIL = 0.008
 
 
 def _freeze_heap() -> None:

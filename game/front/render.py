@@ -104,7 +104,7 @@ class Renderer:
     MARGIN = 8
 
     def __init__(self, static: StaticScene, size: tuple[int, int],
-                 camera: Camera | None = None) -> None:
+                 camera: Camera | None = None, compose_stripes: int = 1) -> None:
         self.static = static
         self.font = pygame.font.Font(None, 22)
         self.small = pygame.font.Font(None, 18)
@@ -114,7 +114,7 @@ class Renderer:
         self._help_lines: list[str] = []
         self._legend_bar: tuple[tuple[int, float, float], pygame.Surface] | None = None
         self._help_count = 2
-        self.layers = StaticLayers(static)
+        self.layers = StaticLayers(static, compose_stripes)
         self.minimap = Minimap(static)
         self.camera = camera or Camera()
         self._size = (max(size[0], 200), max(size[1], 200))

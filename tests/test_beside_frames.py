@@ -1,0 +1,138 @@
+"""Work the game on a large level does beside its frames gives exactly what it did inside them.
+
+The distance metric's searches in a worker process, spreads searched ahead a ring at a
+time, the field overlay on a thread, the static layer composed in stripes: each must give
+the same metrics, balls and pixels as the synchronous path (docs/play.md, frame times).
+"""
+
+from __future__ import annotations
+
+import os
+import time
+
+os.environ["SDL_VIDEODRIVER"] = "dummy"
+os.environ.setdefault("PYGAME_HIDE_SUPPORT_PROMPT", "1")
+
+import numpy as np
+import pygame
+from scipy.sparse.csgraph import dijkstra
+
+from ai.fields import CompositeField, FieldMatrices
+from ai.params import PFParams
+from game.distance_worker import DistanceWorker
+from game.front.layers import StaticLayers
+from game.front.render import init_pygame
+from game.scene import FieldLayer, SceneBuilder, StaticScene
+from game.trial import TrialSpec, make_world
+from navmesh.graph import NodeGraph, graph_for
+from navmesh.level import load_level
+
+
+def _sparse_grid(seed: int) -> NodeGraph:
+    occupancy = np.random.default_rng(seed).random((30, 40)) > 0.3  # several pieces
+    return NodeGraph.from_grid(occupancy, 0.7, dense=False)
+
+
+def test_ring_by_ring_balls_equal_the_scipy_search() -> None:
+    for seed in range(3):
+        graph = _sparse_grid(seed)
+        unit = graph.adjacency.copy()
+        unit.data[:] = 1.0
+        for src in range(0, graph.n, 37):
+            for max_hops in (0, 1, 4, 30, None):
+                limit = np.inf if max_hops is None else max_hops
+                found = dijkstra(unit, indices=src, limit=limit)
+                inside, hops = graph.hop_ball(src, max_hops)
+                assert np.array_equal(inside, np.flatnonzero(np.isfinite(found)))
+                assert np.array_equal(hops, found[inside].astype(np.int32))
+                assert np.array_equal(hops, graph.hops_from(src, max_hops)[inside])
+
+
+def test_balls_searched_ahead_equal_the_ones_searched_when_needed() -> None:
+    graph = _sparse_grid(1)
+    ahead, now = FieldMatrices(graph, PFParams()), FieldMatrices(graph, PFParams())
+    nodes = [3, 40, 41, 300, 3]
+    for node in nodes:
+        ahead.anticipate(node)
+    ahead.warm(0.0)  # one ring: the first search is left half done
+    assert ahead._warming is not None
+    half_done = ahead._warming[0]
+    # a decision that needs the half-done ball finishes that search, with the same result
+    assert np.array_equal(ahead.conf_spread(half_done), now.conf_spread(half_done))
+    ahead.warm(10.0)
+    for node in nodes:
+        assert ("ball", "C", node) in ahead._rows
+        assert np.array_equal(ahead.conf_spread(node), now.conf_spread(node))
+    assert np.array_equal(ahead.deposit(nodes), now.deposit(nodes))
+
+
+def test_a_field_snapshot_computes_the_fields_of_its_moment() -> None:
+    field = CompositeField(_sparse_grid(2))
+    field.tick(1.0, [5, 60], 200)
+    snapshot = field.snapshot()
+    expected = {k: v.copy() for k, v in field.fields().items()}
+    field.tick(1.0, [6, 61], None)  # the live field moves on; the snapshot does not
+    later = snapshot()
+    assert set(later) == set(expected)
+    assert all(np.array_equal(later[k], expected[k]) for k in expected)
+    assert snapshot.identity != field.snapshot().identity
+
+
+def _worlds(steps: int, worker: DistanceWorker | None, spec: TrialSpec) -> dict:
+    world = make_world(spec)
+    world.m.distance_worker = worker
+    for _ in range(steps):
+        world.step()
+    return world.metrics()
+
+
+def test_the_distance_metric_from_a_worker_process_is_the_same() -> None:
+    spec = TrialSpec("miami", "grid", "pf", "maxmin", "fixed", seed=3)
+    graph = make_world(spec).graph
+    worker = DistanceWorker(graph)
+    try:
+        with_worker = _worlds(400, worker, spec)
+        assert worker._pool is not None  # the searches did run in the worker
+    finally:
+        worker.close()
+    assert with_worker == _worlds(400, None, spec)
+    # a worker that is gone costs time, not the metric: the searches run here instead
+    assert _worlds(400, worker, spec) == with_worker
+
+
+def test_the_overlay_computed_on_a_thread_is_the_synchronous_one() -> None:
+    spec = TrialSpec("tlou", "grid", "pf", "maxmin", "fixed", seed=1)
+    world = make_world(spec)
+    for _ in range(80):
+        world.step()
+    kwargs = {"view_range": world.view_range, "fov_deg": 90.0}
+    now = SceneBuilder(world.level, world.graph, **kwargs).from_world(world, "K")
+    later = SceneBuilder(world.level, world.graph, background_fields=True, **kwargs)
+    scene = later.from_world(world, "K")
+    deadline = time.monotonic() + 30
+    while scene.layer is None and time.monotonic() < deadline:
+        time.sleep(0.01)
+        scene = later.from_world(world, "K")
+    assert scene.layer is not None and now.layer is not None
+    assert np.array_equal(scene.layer.values, now.layer.values)
+    assert np.array_equal(scene.layer.norm, now.layer.norm)
+
+
+def test_a_layer_composed_in_stripes_has_the_pixels_of_one_composed_at_once() -> None:
+    init_pygame()
+    pygame.display.set_mode((320, 240))
+    level = load_level("arkham")
+    graph = graph_for(level, "grid")
+    static = StaticScene.from_level(level, graph)
+    rng = np.random.default_rng(4)
+    first, second = (FieldLayer.from_values("K", rng.normal(size=graph.n)) for _ in range(2))
+    visible = (2.0, 2.0, 14.0, 11.0)
+    at_once, striped = StaticLayers(static), StaticLayers(static, stripes=4)
+    for layers in (at_once, striped):
+        layers.surface(visible, 20.0, first, False)
+    want = pygame.surfarray.array3d(at_once.surface(visible, 20.0, second, False)[0])
+    shown = [pygame.surfarray.array3d(striped.surface(visible, 20.0, second, False)[0])
+             for _ in range(4)]
+    before = pygame.surfarray.array3d(at_once.surface(visible, 20.0, first, False)[0])
+    assert all(np.array_equal(s, before) for s in shown[:3])  # the old layer until complete
+    assert np.array_equal(shown[3], want) and not np.array_equal(want, before)
