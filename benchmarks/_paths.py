@@ -16,3 +16,6 @@ if str(ROOT) not in sys.path:
     sys.path.insert(0, str(ROOT))
 if str(ROOT / "tests") not in sys.path:
     sys.path.append(str(ROOT / "tests"))
+# last, so nothing here shadows the project, yet a worker process started by ``spawn``
+# (which imports the running script again, on this path) still finds this module
+sys.path.append(str(HERE))

@@ -53,6 +53,7 @@ import json
 import math
 import tempfile
 import time
+from typing import Any
 from pathlib import Path
 
 import numpy as np
@@ -100,12 +101,37 @@ def _size(text: str) -> tuple[int, int]:
     return int(rows), int(cols)
 
 
-def measure_game_building(rows: int, cols: int, frames: int, warmup: int) -> Times:
-    """The whole game on a generated building, camera zoomed in on the autopilot."""
+class _ScriptedKeys(PlayGame):
+    """The game with its movement keys held by a script instead of a hand: a direction
+    (one of the 8 the arrow keys give) held for 1.5 s, or until the player stops against
+    a wall, then another drawn from a seeded generator — a player exploring the level."""
+
+    def __init__(self, *args: Any, **kwargs: Any) -> None:
+        self._keys_rng = np.random.default_rng(0)
+        self._held, self._held_since = (1.0, 0.0), 0
+        super().__init__(*args, **kwargs)
+
+    def _steer(self) -> None:
+        world = self.world
+        if world.step_index - self._held_since >= 90 or (
+                world.step_index > self._held_since + 5 and not world.player_moved):
+            angle = float(self._keys_rng.integers(8)) * math.pi / 4
+            self._held, self._held_since = (math.cos(angle), math.sin(angle)), world.step_index
+        self.start()
+        world.player_input = self._held
+        world.sprinting = False
+
+
+def measure_game_building(rows: int, cols: int, frames: int, warmup: int,
+                          driver: str = "keys") -> Times:
+    """The whole game on a generated building, the camera zoomed in on the player, who is
+    driven by scripted keys (``driver="keys"``) or the MaxMin autopilot (``"maxmin"``)."""
     path = Path(tempfile.mkdtemp()) / "building.json"
     path.write_text(json.dumps(building_level(rows, cols, guards=8)))
-    game = PlayGame(PlaySettings(str(path), guards="pf", autopilot="maxmin", overlay="K",
-                                 show_plans=True), lockstep=True, size=(1280, 860))
+    settings = PlaySettings(str(path), guards="pf", overlay="K", show_plans=True,
+                            autopilot="maxmin" if driver == "maxmin" else None)
+    kind = PlayGame if driver == "maxmin" else _ScriptedKeys
+    game = kind(settings, lockstep=True, size=(1280, 860))
     game.camera.zoom = 24.0
     try:
         game.run(warmup)
@@ -219,8 +245,10 @@ def main() -> None:
     parser.add_argument("--overlays", nargs="+", default=list(OVERLAYS), help="overlays measured")
     parser.add_argument("--building", type=_size, default=None, metavar="RxC",
                         help="also the front end alone on an RxC building (e.g. 1000x1000)")
-    parser.add_argument("--game-building", type=_size, default=None, metavar="RxC",
-                        help="also the whole game on an RxC building through the camera")
+    parser.add_argument("--game-building", type=_size, nargs="+", default=[], metavar="RxC",
+                        help="also the whole game on RxC buildings through the camera")
+    parser.add_argument("--driver", choices=["keys", "maxmin"], default="keys",
+                        help="who moves the player in --game-building (default: scripted keys)")
     parser.add_argument("--skip-level", action="store_true", help="only the building runs")
     parser.add_argument("--xvfb", action="store_true",
                         help="run in a real window on a private Xvfb server")
@@ -231,7 +259,7 @@ def main() -> None:
         args.xvfb = True
         args.overlays = ["none", "K"]
         args.building = args.building or (1000, 1000)
-        args.game_building = args.game_building or (36, 48)
+        args.game_building = args.game_building or [(36, 48), (1000, 1000)]
     if args.xvfb:
         from game.front.xvfb import xvfb
 
@@ -252,10 +280,10 @@ def run(args: argparse.Namespace) -> None:
     verdicts: list[tuple[str, float, float]] = []
     _line("bare window 1280x860 (fill + flip only, for calibration)",
           measure_flip((1280, 860), min(args.frames, 300)))
-    if args.game_building:
-        r, c = args.game_building
-        name = f"game on building {r}x{c} (camera, K overlay, plans)"
-        verdicts.append((name, *_line(name, measure_game_building(r, c, args.frames, args.warmup))))
+    for r, c in args.game_building:
+        name = f"game on building {r}x{c} = {r * c} cells (camera, K overlay, plans, {args.driver})"
+        times = measure_game_building(r, c, args.frames, args.warmup, args.driver)
+        verdicts.append((name, *_line(name, times)))
     if args.building:
         r, c = args.building
         times, walls = measure_front_building(r, c, args.frames, args.warmup)
