@@ -3,8 +3,12 @@
 Everything that depends only on the graph and the parameters — the spreads ``γ_I^d`` and
 ``γ_C^d`` per source node, the row-normalised kernel matrix, the connectivity field and the
 candidate sets — is computed once per :class:`~navmesh.graph.NodeGraph` and cached, because
-thousands of trials reuse one graph; nothing is n × n, so large levels fit. A tick and a decision are then a handful of numpy vector operations and one
-sparse matrix-vector product; there is no per-node Python loop (SPEC §3.8).
+thousands of trials reuse one graph; nothing is n × n, so large levels fit. A tick and a
+decision are then a handful of numpy vector operations and one sparse matrix-vector
+product; there is no per-node Python loop (SPEC §3.8). On a graph too large for dense
+tables a spread is kept as its ball (the nodes it reaches and their values) and a decision
+reads K at its candidates alone (:meth:`CompositeField.kernel_at`), summed in the order
+scipy's product sums it: the same bits, without a product over every node per tick.
 
 State arrays are never modified in place: every tick makes new arrays and marks them
 read-only, so references handed out by :meth:`CompositeField.fields` or kept for

@@ -3,14 +3,15 @@ levels through the camera (run by hand).
 
     SDL_VIDEODRIVER=dummy PYTHONPATH=. python benchmarks/frames.py [--level dishonored]
         [--frames 1200] [--warmup 60] [--abstraction grid partition] [--no-extras]
-        [--overlays none K] [--building 1000x1000] [--game-building 48x64]
+        [--overlays none K] [--building 1000x1000] [--game-building 48x64 1000x1000]
+        [--driver keys|maxmin]
 
 Without ``SDL_VIDEODRIVER`` set it opens a real window (e.g. under ``xvfb-run`` or with
 ``DISPLAY`` pointing at an Xvfb server); ``--xvfb`` starts a private Xvfb server for the run
 (:mod:`game.front.xvfb`). ``--acceptance`` is issue 16's measurement in one command — a real
 window under a private Xvfb, dishonored on both abstractions with no overlay and with K,
-the 10^6-cell building through the camera and the game on a 36x48 building — and ends with
-a verdict line per target:
+the game on a 36x48 and on a 10^6-cell building, and the front end alone on the 10^6-cell
+building — and ends with a verdict line per target:
 
     PYTHONPATH=. python benchmarks/frames.py --acceptance
 
@@ -20,9 +21,12 @@ ended: on a shared machine read the figures beside the load (wall time then incl
 waiting for a core, and in a real window for the X server). The first line, a bare window
 that only fills and flips, says what the display itself costs at that moment.
 
-``--game-building RxC``: the whole game (world, AI, scene, drawing) on a generated
-building level (:func:`navmesh.buildings.building_level`) with the camera zoomed in and
-following the MaxMin autopilot, the minimap on. ``--building RxC``: the front end alone on
+``--game-building RxC [RxC ...]``: the whole game (world, 8 PF guards, scene, drawing) on
+generated building levels (:func:`navmesh.buildings.building_level`) with the camera zoomed
+in on the player and the minimap on; the player is on the keyboard, its keys held by a
+script (``--driver keys``, the default: what a player costs the game) or the MaxMin
+autopilot (``--driver maxmin``: on a 10^6-cell level the policy's own whole-graph search
+per guard move shows in the frames). ``--building RxC``: the front end alone on
 a building of R×C cells (10^6 with 1000x1000) — a level too large for the simulation's
 all-pairs distance tables — with 12 guards walking around the player, their cones cast
 against the level's walls every frame (the scene builder's wall buckets), the camera
@@ -31,8 +35,9 @@ following the player and the minimap: what a frame costs besides ``world.step()`
 Each frame is what ``stealth play`` does once per frame in lockstep: events, one physics
 step (``world.step()``, 1/60 s, with the AI's decisions and its 1-s tick), the scene
 (cones ray-cast against the walls, plans, field layer) and the pygame drawing, plus the
-display flip. Guards are ``pf`` (the only mode with fields), the player is the MaxMin
-autopilot, and by default the navmesh/grid lines and the guards' plans are shown too, so
+display flip, then the guard AI's work ahead when the frame ended early. Guards are ``pf``
+(the only mode with fields), the player on the paper level is the MaxMin autopilot, and by
+default the navmesh/grid lines and the guards' plans are shown too, so
 this is the busiest picture the game draws. The first ``--warmup`` frames (world
 construction caches, first composition of the background) are not counted.
 

@@ -409,6 +409,14 @@ class SceneBuilder:
             self._pending = (overlay, identity, job)
         return shown[1] if shown is not None else (None, "")
 
+    def settle(self) -> bool:
+        """Wait for the layer being computed on the worker (if any); whether there was one."""
+        pending, self._pending = self._pending, None
+        if pending is None:
+            return False
+        self._shown[pending[0]] = (pending[1], pending[2].result())
+        return True
+
     # ------------------------------------------------------------------ from a world
     def from_world(self, world: World, overlay: str = "none", plans: bool = False) -> Scene:
         """The frame of ``world`` now, with the ``overlay`` field and optionally the plans."""

@@ -136,6 +136,11 @@ class StaticLayers:
         assert self._composite is not None
         return self._composite, self.region
 
+    @property
+    def composing(self) -> bool:
+        """Whether a new field layer is still being composed in stripes."""
+        return self._next is not None
+
     def _compose_in_stripes(self, layer: FieldLayer | None, show_mesh: bool) -> None:
         """New values of the same field over the same region: composed one of ``stripes``
         stripes per frame into the spare surface, copied into the composite when complete

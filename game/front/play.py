@@ -479,6 +479,17 @@ class PlayGame(FrameLoop):
         if spare > 0 and not self.idle():
             self.world.guard_ai.prepare(spare)
 
+    def settle_view(self) -> None:
+        """Draw the current moment until the picture shows all of it — on a large level the
+        overlay of the current field, computed beside the frames and composed in stripes —
+        without stepping the world: what a screenshot of this moment should show."""
+        for _ in range(100):
+            self.draw()
+            waited = self.builder.settle()
+            if not waited and not self.renderer.layers.composing:
+                self.draw()
+                return
+
     def close(self) -> None:
         """Store the session still open (if recording) and give the frozen heap back."""
         self._close_session("quit")

@@ -184,7 +184,7 @@ def main(argv: list[str] | None = None) -> int:
     for name in args.only or SHOTS:
         made = SHOTS[name]()
         if isinstance(made, PlayGame):
-            made.draw()
+            made.settle_view()  # a large level's overlay is made beside the frames: wait for it
             surface = made.screen
         else:
             surface = made
