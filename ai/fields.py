@@ -76,42 +76,45 @@ class FieldMatrices:
         #: per node, the nodes a guard standing there may choose (SPEC §3.5)
         self.candidates = CandidateSets(graph, params.r_edge_factor)
         self._rows = RowCache(SPREAD_CACHE_BYTES)
-        #: large graph: nodes whose confidence ball will soon be read (guards' next nodes),
-        #: and the one being searched ahead (:meth:`warm`)
-        self._ahead: deque[int] = deque()
-        self._warming: tuple[int, Generator[None, None, tuple[np.ndarray, np.ndarray]]] | None = None
+        #: large graph: the balls that will soon be read, as (field, node) — guards' next
+        #: nodes ("C"), the player's node while seen ("I") — and the one being searched
+        #: ahead (:meth:`warm`)
+        self._ahead: deque[tuple[str, int]] = deque()
+        self._warming: tuple[str, int, Generator[None, None, tuple[np.ndarray, np.ndarray]]] | None = None
         if not graph.dense:
             graph.hop_ball(0, 0)  # the searches' neighbour table, built now rather than mid-game
 
-    def anticipate(self, node: int) -> None:
-        """``node``'s confidence ball will be needed soon (a guard heads there): on a large
-        graph, queue it for :meth:`warm`."""
+    def anticipate(self, node: int, which: str = "C") -> None:
+        """``node``'s ball of field ``which`` ("C": a guard heads there, "I": the player is
+        seen there) will be needed soon: on a large graph, queue it for :meth:`warm`."""
         if not self.graph.dense:
-            self._ahead.append(int(node))
+            self._ahead.append((which, int(node)))
 
     def warm(self, budget: float) -> None:
         """Search the queued balls not yet kept for about ``budget`` seconds, a ring at a
-        time, at least one (a search left unfinished goes on at the next call): work the game does in a
-        frame's spare time, so the next tick and decisions find the balls. Values never
-        depend on it."""
+        time, at least one (a search left unfinished goes on at the next call): work the game
+        does in a frame's spare time, so the next tick and decisions find the balls. Values
+        never depend on it."""
         deadline = time.perf_counter() + budget
         first = True  # at least one ring per call, whatever the budget
         while first or time.perf_counter() < deadline:
             first = False
             if self._warming is None:
-                while self._ahead and ("ball", "C", self._ahead[0]) in self._rows:
+                while self._ahead and ("ball", *self._ahead[0]) in self._rows:
                     self._ahead.popleft()
                 if not self._ahead:
                     return
-                node = self._ahead.popleft()
-                self._warming = (node, self.graph.hop_ball_search(node, self.depth_C))
-            node, search = self._warming
+                which, node = self._ahead.popleft()
+                depth = self._gamma_depth(which)[1]
+                self._warming = (which, node, self.graph.hop_ball_search(node, depth))
+            which, node, search = self._warming
             try:
                 next(search)
             except StopIteration as done:
                 self._warming = None
                 inside, hops = done.value
-                self._rows.get(("ball", "C", node), lambda: self._ball_values("C", inside, hops))
+                self._rows.get(("ball", which, node),
+                               lambda: self._ball_values(which, inside, hops))
 
     def _spread(self, which: str, node: int) -> np.ndarray:
         """(n,) ``γ ** d(node, ·)``, read-only: a cached row on a dense graph, else made
@@ -130,9 +133,9 @@ class FieldMatrices:
         with zeros (and a sum of them would add zeros)."""
         def make() -> tuple[np.ndarray, np.ndarray]:
             warming = self._warming
-            if warming is not None and which == "C" and warming[0] == node:
+            if warming is not None and warming[:2] == (which, node):
                 self._warming = None  # being searched ahead: finish that search
-                return self._ball_values(which, *_drain(warming[1]))
+                return self._ball_values(which, *_drain(warming[2]))
             return self._ball_values(which, *self.graph.hop_ball(node, self._gamma_depth(which)[1]))
 
         inside, values = self._rows.get(("ball", which, node), make)

@@ -102,6 +102,9 @@ class PotentialFieldGuards(GuardAI):
         personal = None if own is None else own[0]
         choice = field.select(node, self.rng, teammates, recent, personal)
         field.matrices.anticipate(choice.winner)  # the guard's next node: its deposit ahead
+        seen = sighting_node(view)
+        if seen is not None:  # the next tick spreads information from here (if still seen)
+            field.matrices.anticipate(seen, "I")
         self._last[i] = _Decision(
             t=float(view.t),
             node=node,

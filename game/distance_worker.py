@@ -38,7 +38,11 @@ def _load(path: str) -> None:
     the lowest priority (the frames, and the display server, come first)."""
     global _GRAPH
     lowest_priority()
-    with np.load(path) as saved:
+    try:
+        saved = np.load(path)
+    except OSError:  # the game closed before this worker started: nothing left to do
+        return
+    with saved:
         indptr, indices = saved["indptr"], saved["indices"]
         neighbors = [indices[indptr[i]:indptr[i + 1]] for i in range(len(indptr) - 1)]
         _GRAPH = NodeGraph(kind=str(saved["kind"]), positions=saved["positions"],

@@ -11,6 +11,7 @@ on the same level and seeds.
 from __future__ import annotations
 
 import re
+import sys
 from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any
@@ -63,5 +64,9 @@ class SessionStore:
                     seed=int(row["seed"]), overrides=tuple(dict(row["overrides"]).items()),
                 )
                 if spec.key + "/interactive" not in done:
+                    # a 60-s trial: a moment on a paper level, a minute or so at 10^6 cells
+                    print(f"stealth: session {row['key']}: the {player} trial on the same "
+                          "level and seed, for the report's comparison ...",
+                          file=sys.stderr, flush=True)
                     store.add(policy_row(spec, config))
         self.stored.append(str(row["key"]))

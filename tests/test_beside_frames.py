@@ -56,7 +56,7 @@ def test_balls_searched_ahead_equal_the_ones_searched_when_needed() -> None:
         ahead.anticipate(node)
     ahead.warm(0.0)  # one ring: the first search is left half done
     assert ahead._warming is not None
-    half_done = ahead._warming[0]
+    half_done = ahead._warming[1]
     # a decision that needs the half-done ball finishes that search, with the same result
     assert np.array_equal(ahead.conf_spread(half_done), now.conf_spread(half_done))
     ahead.warm(10.0)
@@ -64,6 +64,10 @@ def test_balls_searched_ahead_equal_the_ones_searched_when_needed() -> None:
         assert ("ball", "C", node) in ahead._rows
         assert np.array_equal(ahead.conf_spread(node), now.conf_spread(node))
     assert np.array_equal(ahead.deposit(nodes), now.deposit(nodes))
+    ahead.anticipate(7, "I")  # a sighting's information ball, searched ahead as well
+    ahead.warm(10.0)
+    assert ("ball", "I", 7) in ahead._rows
+    assert np.array_equal(ahead.info_spread(7), now.info_spread(7))
 
 
 def test_a_field_snapshot_computes_the_fields_of_its_moment() -> None:
