@@ -85,6 +85,14 @@ class Counters:
             self.dist_sum += self._dist_now
             self.dist_samples += 1
 
+    def distances_ready(self) -> bool:
+        """Whether :meth:`settle` would not wait: every search handed to the worker is done."""
+        return all(run[0].done() for run in self._dist_runs)
+
+    def distances_pending(self) -> int:
+        """How many of the worker's searches are not done yet."""
+        return sum(1 for run in self._dist_runs if not run[0].done())
+
     def settle(self) -> None:
         """Add the worker's distances to ``dist_sum`` — one addition per step, in step
         order, as :meth:`sample_distance` adds them without a worker (the same bits)."""

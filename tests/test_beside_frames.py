@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import os
 import time
+from concurrent.futures import Future
 
 os.environ["SDL_VIDEODRIVER"] = "dummy"
 os.environ.setdefault("PYGAME_HIDE_SUPPORT_PROMPT", "1")
@@ -140,3 +141,46 @@ def test_a_layer_composed_in_stripes_has_the_pixels_of_one_composed_at_once() ->
     before = pygame.surfarray.array3d(at_once.surface(visible, 20.0, first, False)[0])
     assert all(np.array_equal(s, before) for s in shown[:3])  # the old layer until complete
     assert np.array_equal(shown[3], want) and not np.array_equal(want, before)
+
+
+class _SlowWorker:
+    """A worker whose searches finish when the test says so."""
+
+    def __init__(self, graph: NodeGraph) -> None:
+        self.graph, self.searches = graph, []
+
+    def submit(self, guard_nodes, player_node):  # type: ignore[no-untyped-def]
+        search: Future[float] = Future()
+        self.searches.append((search, guard_nodes, player_node))
+        return search
+
+    def value(self, search, guard_nodes, player_node):  # type: ignore[no-untyped-def]
+        return float(search.result())
+
+    def finish(self) -> None:
+        for search, guards, player in self.searches:
+            if not search.done():
+                search.set_result(self.graph.nearest_dist_to(list(guards), player))
+
+
+def test_the_game_over_screen_does_not_wait_for_the_worker() -> None:
+    """While searches are pending the end screen says so (no frame blocks); once they are
+    done it shows the trial's metrics."""
+    from game.front.play import PlayGame, PlaySettings
+
+    game = PlayGame(PlaySettings("miami", guards="pf", autopilot="maxmin",
+                                 overrides=("world.duration=3",)), lockstep=True, size=(640, 480))
+    worker = _SlowWorker(game.world.graph)
+    game.world.m.distance_worker = worker  # type: ignore[assignment]
+    try:
+        game.run(200)  # 3 s of game: over
+        assert game.state == "over" and game.world.m.distances_pending() > 0
+        panel = game.panel()
+        assert panel is not None and "follow in a moment" in " ".join(panel.lines)
+        worker.finish()
+        assert game.world.m.distances_ready()
+        lines = " ".join(game.panel().lines)  # type: ignore[union-attr]
+        assert "mean guard distance" in lines
+        assert game.world.metrics()["avg_guard_player_dist"] > 0
+    finally:
+        game.close()

@@ -134,6 +134,8 @@ class PlayGame(FrameLoop):
         self.sessions: list[dict[str, Any]] = []
         self._size, self._screen = size, screen
         self._distances: DistanceWorker | None = None
+        #: the game ended, recording, before the distance searches were done: store then
+        self._store_when_ready = False
         self._load(settings.level, settings.guards)
         _freeze_heap()
 
@@ -236,6 +238,11 @@ class PlayGame(FrameLoop):
             return
         if not self.outcome:
             self.outcome = why
+        self._store_when_ready = False
+        pending = self.world.m.distances_pending()
+        if pending:
+            print(f"stealth: storing the session once the distance metric's last {pending} "
+                  "search(es) are done ...", file=sys.stderr, flush=True)
         row = self.recording.finish(self.world, self._result(), self.answers)
         self.sessions.append(row)
         if self.on_session is not None:
@@ -251,9 +258,11 @@ class PlayGame(FrameLoop):
             self.outcome = "survived" if not self.goal.has_goal else "time up"
         if self.recording is not None and self.settings.questions:
             self.state = "questions"
-        else:
+        elif self.world.m.distances_ready():
             self.state = "over"
             self._close_session(self.outcome)
+        else:  # a large level: stored once the distance metric's searches are done (update)
+            self.state, self._store_when_ready = "over", True
 
     # ------------------------------------------------------------------ input
     def help_items(self) -> list[str]:
@@ -379,6 +388,10 @@ class PlayGame(FrameLoop):
         """Advance the world: one step in lockstep, else ``elapsed`` seconds of game time."""
         if self.paused or self.state in ("over", "questions"):
             self._accumulator = 0.0
+            if self._store_when_ready and self.world.m.distances_ready():
+                self._store_when_ready = False
+                self._close_session(self.outcome)
+                self.flash("session recorded", GOOD)
             return
         self._steer()
         if self.state == "ready":
@@ -414,10 +427,15 @@ class PlayGame(FrameLoop):
         return None
 
     def _over_panel(self) -> Panel:
-        m = self.world.metrics()
         titles = {"won": ("ESCAPED", GOOD), "caught": ("CAUGHT", BAD),
                   "survived": ("SURVIVED", GOOD), "time up": ("TIME UP", WARN)}
         title, color = titles.get(self.outcome, (self.outcome.upper(), WARN))
+        hint = "Enter restart · N next level · 1-5 other guards · Esc quit"
+        pending = self.world.m.distances_pending()
+        if pending:  # a large level: the metrics wait for the worker; the window does not
+            return Panel(title, [f"time {self.world.t:.1f} s · the metrics follow in a moment "
+                                 f"({pending} distance searches to go)"], color, hint=hint)
+        m = self.world.metrics()
         seen = m["first_detect_time"]
         lines = [f"time {self.world.t:.1f} s · captures {m['captures']} · first seen "
                  + ("never" if seen is None else f"at {seen:.1f} s")]
@@ -425,8 +443,7 @@ class PlayGame(FrameLoop):
                      f"{100 * m['coverage']:.0f} %"
                      + (f" · stars {int(self.goal.collected.sum())}/{len(self.goal.collected)}"
                         if len(self.goal.collected) else ""))
-        return Panel(title, lines, color,
-                     hint="Enter restart · N next level · 1-5 other guards · Esc quit")
+        return Panel(title, lines, color, hint=hint)
 
     def options(self) -> DrawOptions:
         """Display options and HUD texts for this frame."""
