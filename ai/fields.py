@@ -36,7 +36,14 @@ from typing import NamedTuple
 import numpy as np
 from scipy import sparse
 
-from navmesh.graph import UNREACHABLE_HOPS, NodeGraph, RowCache, falloff_depth, hop_ball_pairs
+from navmesh.graph import (
+    UNREACHABLE_HOPS,
+    NodeGraph,
+    RowCache,
+    falloff_depth,
+    finish_search,
+    hop_ball_pairs,
+)
 
 from .params import PFParams
 from .view import WorldView
@@ -135,7 +142,7 @@ class FieldMatrices:
             warming = self._warming
             if warming is not None and warming[:2] == (which, node):
                 self._warming = None  # being searched ahead: finish that search
-                return self._ball_values(which, *_drain(warming[2]))
+                return self._ball_values(which, *finish_search(warming[2]))
             return self._ball_values(which, *self.graph.hop_ball(node, self._gamma_depth(which)[1]))
 
         inside, values = self._rows.get(("ball", which, node), make)
@@ -343,17 +350,6 @@ def candidate_sets(graph: NodeGraph, r_edge_factor: float) -> tuple[np.ndarray, 
     """Every node's candidate set (:class:`CandidateSets`), e.g. for tests and plots."""
     sets = CandidateSets(graph, r_edge_factor)
     return tuple(sets[s] for s in range(graph.n))
-
-
-def _drain(search: Generator[None, None, tuple[np.ndarray, np.ndarray]],
-           ) -> tuple[np.ndarray, np.ndarray]:
-    """Run a paused search to its end: its result."""
-    while True:
-        try:
-            next(search)
-        except StopIteration as done:
-            found: tuple[np.ndarray, np.ndarray] = done.value
-            return found
 
 
 def _read_only(array: np.ndarray) -> np.ndarray:

@@ -139,6 +139,17 @@ def _nbytes(value: object) -> int:
     return sum(getattr(value, part).nbytes for part in ("data", "indices", "indptr"))
 
 
+def finish_search(search: Generator[None, None, tuple[np.ndarray, np.ndarray]],
+                  ) -> tuple[np.ndarray, np.ndarray]:
+    """Run a paused :meth:`NodeGraph.hop_ball_search` to its end: its result."""
+    while True:
+        try:
+            next(search)
+        except StopIteration as done:
+            found: tuple[np.ndarray, np.ndarray] = done.value
+            return found
+
+
 def _as_hops(found: np.ndarray) -> np.ndarray:
     """A float hop array from a search as int32, :data:`UNREACHABLE_HOPS` where infinite."""
     out = np.full(found.shape, UNREACHABLE_HOPS, dtype=np.int32)
@@ -327,13 +338,7 @@ class NodeGraph:
             row = self._hops[s]
             inside = np.flatnonzero(row < UNREACHABLE_HOPS if max_hops is None else row <= max_hops)
             return inside, row[inside]
-        search = self.hop_ball_search(s, max_hops)
-        while True:
-            try:
-                next(search)
-            except StopIteration as done:
-                found: tuple[np.ndarray, np.ndarray] = done.value
-                return found
+        return finish_search(self.hop_ball_search(s, max_hops))
 
     def hop_ball_search(self, src: int, max_hops: int | None = None,
                         ) -> Generator[None, None, tuple[np.ndarray, np.ndarray]]:
