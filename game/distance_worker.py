@@ -61,24 +61,29 @@ class DistanceWorker:
         self.graph = graph
         # The graph goes by a file, not through the start-up pipe: a worker that died while
         # reading tens of MB from it would leave this process blocked writing them.
-        self._folder = tempfile.mkdtemp(prefix="stealth-distances-")
-        path = os.path.join(self._folder, "graph.npz")
-        neighbors = graph.neighbors
-        np.savez(path, kind=graph.kind, positions=np.asarray(graph.positions),
-                 indptr=np.asarray(neighbors.indptr), indices=np.asarray(neighbors.indices),  # type: ignore[attr-defined]
-                 cell_size=float(graph.cell_size))
+        self._folder = ""
+        self._pool: ProcessPoolExecutor | None = None
+        try:
+            self._folder = tempfile.mkdtemp(prefix="stealth-distances-")
+            path = os.path.join(self._folder, "graph.npz")
+            neighbors = graph.neighbors
+            np.savez(path, kind=graph.kind, positions=np.asarray(graph.positions),
+                     indptr=np.asarray(neighbors.indptr), indices=np.asarray(neighbors.indices),  # type: ignore[attr-defined]
+                     cell_size=float(graph.cell_size))
+        except OSError:  # no room for the file (a full disk): the searches run here
+            self.close()
+            return
         # spawn, not fork: the game process holds a display connection and threads
-        self._pool: ProcessPoolExecutor | None = ProcessPoolExecutor(
-            1, mp_context=multiprocessing.get_context("spawn"), initializer=_load,
-            initargs=(path,))
+        self._pool = ProcessPoolExecutor(1, mp_context=multiprocessing.get_context("spawn"),
+                                         initializer=_load, initargs=(path,))
 
     def submit(self, guard_nodes: tuple[int, ...], player_node: int) -> Future[float]:
         """The distance, computed in the worker (or here, if the worker is gone)."""
         if self._pool is not None:
             try:
                 return self._pool.submit(_nearest, tuple(guard_nodes), int(player_node))
-            except RuntimeError:  # broken or shut down: compute here from now on
-                self._pool = None
+            except (RuntimeError, OSError):  # broken, shut down or not startable: here from now on
+                self.close()
         done: Future[float] = Future()
         done.set_result(self.graph.nearest_dist_to(list(guard_nodes), int(player_node)))
         return done
@@ -95,7 +100,8 @@ class DistanceWorker:
         if self._pool is not None:
             self._pool.shutdown(wait=False, cancel_futures=True)
             self._pool = None
-        shutil.rmtree(self._folder, ignore_errors=True)
+        if self._folder:
+            shutil.rmtree(self._folder, ignore_errors=True)
 
     def __getstate__(self) -> dict[str, Any]:
         raise TypeError("a DistanceWorker belongs to one process")

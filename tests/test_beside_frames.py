@@ -184,3 +184,19 @@ def test_the_game_over_screen_does_not_wait_for_the_worker() -> None:
         assert game.world.metrics()["avg_guard_player_dist"] > 0
     finally:
         game.close()
+
+
+def test_without_room_for_the_worker_the_searches_run_here(monkeypatch) -> None:  # type: ignore[no-untyped-def]
+    """No space for the graph's file (a full disk): no worker, the same distances."""
+    import game.distance_worker as module
+
+    def full_disk(*args, **kwargs):  # type: ignore[no-untyped-def]
+        raise OSError(28, "No space left on device")
+
+    monkeypatch.setattr(module.tempfile, "mkdtemp", full_disk)
+    graph = _sparse_grid(0)
+    worker = DistanceWorker(graph)
+    assert worker._pool is None
+    found = worker.submit((3, 50), 200)
+    assert worker.value(found, (3, 50), 200) == graph.nearest_dist_to([3, 50], 200)
+    worker.close()
