@@ -37,7 +37,6 @@ import numpy as np
 from scipy import sparse
 
 from navmesh.graph import (
-    UNREACHABLE_HOPS,
     NodeGraph,
     RowCache,
     falloff_depth,
@@ -128,10 +127,11 @@ class FieldMatrices:
         from the cached ball (:meth:`_ball`)."""
         if self.graph.dense:
             return self._rows.get((which, node), lambda: (self._spread_row(which, node),))[0]
-        inside, values = self._ball(which, node)
+        return _read_only(self._row_of(*self._ball(which, node)))
+
+    def _row_of(self, inside: np.ndarray, values: np.ndarray) -> np.ndarray:
         row = np.zeros(self.graph.n)
         row[inside] = values
-        row.flags.writeable = False
         return row
 
     def _ball(self, which: str, node: int) -> tuple[np.ndarray, np.ndarray]:
@@ -143,7 +143,7 @@ class FieldMatrices:
             if warming is not None and warming[:2] == (which, node):
                 self._warming = None  # being searched ahead: finish that search
                 return self._ball_values(which, *finish_search(warming[2]))
-            return self._ball_values(which, *self.graph.hop_ball(node, self._gamma_depth(which)[1]))
+            return self._search_ball(which, node)
 
         inside, values = self._rows.get(("ball", which, node), make)
         return inside, values
@@ -155,14 +155,13 @@ class FieldMatrices:
     def _gamma_depth(self, which: str) -> tuple[float, int | None]:
         return (self.gamma_I, self.depth_I) if which == "I" else (self.gamma_C, self.depth_C)
 
+    def _search_ball(self, which: str, node: int) -> tuple[np.ndarray, np.ndarray]:
+        """The ball of :meth:`_ball`, searched now (uncached)."""
+        return self._ball_values(which, *self.graph.hop_ball(node, self._gamma_depth(which)[1]))
+
     def _spread_row(self, which: str, node: int) -> np.ndarray:
         """(n,) ``γ ** d(node, ·)`` cut at the field's depth (uncached)."""
-        gamma, depth = self._gamma_depth(which)
-        hops = self.graph.hops_from(node, max_hops=depth)
-        inside = np.flatnonzero(hops < UNREACHABLE_HOPS)
-        row = np.zeros(self.graph.n)
-        row[inside] = gamma ** hops[inside].astype(np.float64)
-        return row
+        return self._row_of(*self._search_ball(which, node))
 
     def info_spread(self, node: int) -> np.ndarray:
         """(n,) ``γ_I ** d(node, ·)``: the information spread of a sighting at ``node`` (read-only)."""
@@ -587,9 +586,8 @@ class CompositeField:
     # ------------------------------------------------------------------ potential and kernel
     def _refresh(self) -> None:
         if self._cached_version != self._version:
-            potential = self.potential_at(slice(None))
-            self._potential = _read_only(potential)
-            self._kernel = _read_only(self.matrices.kernel @ potential)
+            fields = self.snapshot()()
+            self._potential, self._kernel = fields["P"], fields["K"]
             self._cached_version = self._version
 
     def potential_at(self, at: np.ndarray | slice) -> np.ndarray:

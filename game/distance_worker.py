@@ -24,7 +24,7 @@ from typing import Any
 
 import numpy as np
 
-from navmesh.graph import NodeGraph
+from navmesh.graph import Neighbours, NodeGraph
 
 from .background import lowest_priority
 
@@ -43,10 +43,9 @@ def _load(path: str) -> None:
     except OSError:  # the game closed before this worker started: nothing left to do
         return
     with saved:
-        indptr, indices = saved["indptr"], saved["indices"]
-        neighbors = [indices[indptr[i]:indptr[i + 1]] for i in range(len(indptr) - 1)]
         _GRAPH = NodeGraph(kind=str(saved["kind"]), positions=saved["positions"],
-                           neighbors=neighbors, cell_size=float(saved["cell_size"]), dense=False)
+                           neighbors=Neighbours(saved["indptr"], saved["indices"]),
+                           cell_size=float(saved["cell_size"]), dense=False)
 
 
 def _nearest(guard_nodes: tuple[int, ...], player_node: int) -> float:

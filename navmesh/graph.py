@@ -8,10 +8,12 @@ running on.
 Distances are computed on demand, so memory grows with the level rather than its square:
 a graph of at most :data:`DENSE_MAX_NODES` nodes (every bundled level) computes its dense
 all-pairs matrices once, because that is cheapest there; a larger one answers each query
-with a search from the source (:func:`scipy.sparse.csgraph.dijkstra`) and keeps the last
-rows in a cache bounded in bytes (:data:`ROW_CACHE_BYTES`). Both run the same per-source
-search on the same CSR matrix, so every answer is bit-identical whichever path a graph
-takes (tests/test_graph_queries.py checks it).
+with a search from the source — metric distances by :func:`scipy.sparse.csgraph.dijkstra`,
+hop counts by a breadth-first search ring by ring (:meth:`NodeGraph.hop_ball_search`) — and
+keeps the last rows in a cache bounded in bytes (:data:`ROW_CACHE_BYTES`). Metric queries
+run the same per-source search on the same CSR matrix either way and hop counts are exact
+integers, so every answer is bit-identical whichever path a graph takes
+(tests/test_graph_queries.py checks it).
 """
 
 from __future__ import annotations
@@ -323,11 +325,13 @@ class NodeGraph:
             out = np.where(row <= max_hops, row, UNREACHABLE_HOPS).astype(np.int32)
             out.flags.writeable = False
             return out
-        limit = np.inf if max_hops is None else float(max_hops)
-        (row,) = self._rows.get(
-            ("hops", s, max_hops),
-            lambda: (_as_hops(dijkstra(self._unit_adjacency, indices=s, limit=limit)),),
-        )
+        def make() -> tuple[np.ndarray]:
+            inside, hops = self.hop_ball(s, max_hops)
+            row = np.full(self.n, UNREACHABLE_HOPS, dtype=np.int32)
+            row[inside] = hops
+            return (row,)
+
+        (row,) = self._rows.get(("hops", s, max_hops), make)
         return row
 
     def hop_ball(self, src: int, max_hops: int | None = None) -> tuple[np.ndarray, np.ndarray]:
@@ -368,14 +372,6 @@ class NodeGraph:
             yield
         nodes = np.flatnonzero(visited[: self.n])
         return nodes, hop[nodes]
-
-    @cached_property
-    def _unit_adjacency(self) -> csr_matrix:
-        """The adjacency with every edge 1: a Dijkstra search on it counts hops (what
-        ``unweighted=True`` does, without copying the weights on every search)."""
-        unit = self.adjacency.copy()
-        unit.data = np.ones_like(unit.data)
-        return unit
 
     @cached_property
     def _neighbour_table(self) -> np.ndarray:
