@@ -123,16 +123,11 @@ class StaticLayers:
             self._new_region(visible, scale)
         assert self.region is not None
         key = (id(layer) if layer is not None else None, show_mesh)
-        if (self._composite is None or key[1] != self._composite_key[1]  # type: ignore[index]
-                or _layer_key(layer) != _layer_key(self._layer)):  # a toggle shows at once
-            self._compose(layer, show_mesh)
-            self._composite_key, self._layer, self._next = key, layer, None
-        elif key != self._composite_key or layer is not self._layer:
-            if self.stripes > 1:
-                self._compose_in_stripes(layer, show_mesh)
-            else:
-                self._compose(layer, show_mesh)
-                self._composite_key, self._layer = key, layer
+        at_once = (self._composite is None or self._composite_key is None
+                   or show_mesh != self._composite_key[1]
+                   or _layer_key(layer) != _layer_key(self._layer))  # a toggle shows at once
+        if at_once or key != self._composite_key or layer is not self._layer:
+            self._compose(layer, show_mesh, at_once or self.stripes == 1)
         assert self._composite is not None
         return self._composite, self.region
 
@@ -141,31 +136,42 @@ class StaticLayers:
         """Whether a new field layer is still being composed in stripes."""
         return self._next is not None
 
-    def _compose_in_stripes(self, layer: FieldLayer | None, show_mesh: bool) -> None:
-        """New values of the same field over the same region: composed one of ``stripes``
-        stripes per frame into the spare surface, copied into the composite when complete
-        (the old composite is shown until then). A field changes once per AI tick; composing the
-        region at once costs a large level's frame ~10 ms, a stripe a quarter of it
-        (``stripes`` > 1: the game on a large level; else a layer is composed at once, so a
-        rendered scene always shows its own layer)."""
-        if self._next is None or self._next[0] is not layer:
-            spare = self._blank("composite-next")
-            self._next = (layer, spare, 0)
-        _, surface, stripe = self._next
-        width, height = surface.get_size()
+    def _compose(self, layer: FieldLayer | None, show_mesh: bool, at_once: bool) -> None:
+        """Base, field, mesh and line layers into the spare surface — all of it, or the next
+        of ``stripes`` stripes — and, once complete, copied into the composite that
+        :meth:`surface` returns (the old one is shown until then).
+
+        New values of the same field (once per AI tick) come in stripes when ``stripes`` > 1
+        (the game on a large level, where composing the region costs a frame ~10 ms, a stripe
+        a quarter of it); anything else, and every small level, at once, so a rendered scene
+        shows its own layer. The spare is copied, not swapped with the composite: the line
+        layer is RLE-encoded for the one surface it is blitted onto, and SDL encodes it again
+        for every other (measured: 13 ms at 10^6 cells).
+        """
+        if at_once or self._next is None or self._next[0] is not layer:
+            self._next = (layer, self._blank("composite-next"), 0)
+        _, spare, stripe = self._next
+        done = self.stripes if at_once else stripe + 1
+        width, height = spare.get_size()
         top = height * stripe // self.stripes
-        bottom = height * (stripe + 1) // self.stripes
-        surface.set_clip(pygame.Rect(0, top, width, bottom - top))
-        self._compose(layer, show_mesh, surface)
-        surface.set_clip(None)
-        if stripe + 1 < self.stripes:
-            self._next = (layer, surface, stripe + 1)
+        spare.set_clip(pygame.Rect(0, top, width, height * done // self.stripes - top))
+        spare.blit(self._base_surface(), (0, 0))
+        if layer is not None:
+            self._draw_field(spare, layer.norm)
+        if show_mesh:
+            if self._mesh is None:
+                self._mesh = self._keyed(self._draw_mesh)
+            spare.blit(self._mesh, (0, 0))
+        if self._lines is None:
+            self._lines = self._keyed(self._draw_lines)
+        spare.blit(self._lines, (0, 0))
+        spare.set_clip(None)
+        if done < self.stripes:
+            self._next = (layer, spare, done)
             return
-        # copied, not swapped: the line layer is RLE-encoded for the one surface it is blitted
-        # onto, and SDL encodes it again for every other (measured: 13 ms at 10^6 cells)
-        assert self._composite is not None
-        self._composite.blit(surface, (0, 0))
-        self._next = None
+        composite = self._blank("composite")
+        composite.blit(spare, (0, 0))
+        self._composite, self._next = composite, None
         self._composite_key, self._layer = (id(layer) if layer is not None else None, show_mesh), layer
 
     # ------------------------------------------------------------------ building
@@ -186,33 +192,6 @@ class StaticLayers:
         assert r is not None
         p = (np.asarray(points, dtype=float).reshape(-1, 2) - (r.x0, r.y0)) * r.scale
         return [(float(x), float(y)) for x, y in p]
-
-    def _compose(self, layer: FieldLayer | None, show_mesh: bool,
-                 surface: pygame.Surface | None = None) -> None:
-        """Base, field, mesh and line layers into the composite (or into ``surface``,
-        within its clip rectangle, without making it the composite). In stripes mode all
-        drawing goes to the one spare surface, copied into the composite when complete."""
-        base = self._base_surface()
-        into = surface
-        if into is None:
-            surface = self._blank("composite-next" if self.stripes > 1 else "composite")
-        assert surface is not None
-        surface.blit(base, (0, 0))
-        if layer is not None:
-            self._draw_field(surface, layer.norm)
-        if show_mesh:
-            if self._mesh is None:
-                self._mesh = self._keyed(self._draw_mesh)
-            surface.blit(self._mesh, (0, 0))
-        if self._lines is None:
-            self._lines = self._keyed(self._draw_lines)
-        surface.blit(self._lines, (0, 0))
-        if into is None and self.stripes > 1:
-            composite = self._blank("composite")
-            composite.blit(surface, (0, 0))
-            self._composite = composite
-        elif into is None:
-            self._composite = surface
 
     def _blank(self, role: str) -> pygame.Surface:
         """The surface of one role (base, composite, line layers) at the region's size,
