@@ -87,7 +87,7 @@ class Counters:
 
     def distances_ready(self) -> bool:
         """Whether :meth:`settle` would not wait: every search handed to the worker is done."""
-        return all(run[0].done() for run in self._dist_runs)
+        return self.distances_pending() == 0
 
     def distances_pending(self) -> int:
         """How many of the worker's searches are not done yet."""

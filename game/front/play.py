@@ -519,7 +519,6 @@ class PlayGame(FrameLoop):
             self._distances = None
 
 
-
 #: Seconds into a frame up to which the guard AI may work ahead (half a 60 Hz frame).
 WORK_AHEAD_UNTIL = 0.008
 
