@@ -139,7 +139,8 @@ class StaticLayers:
     def _compose(self, layer: FieldLayer | None, show_mesh: bool, at_once: bool) -> None:
         """Base, field, mesh and line layers into the spare surface — all of it, or the next
         of ``stripes`` stripes — and, once complete, copied into the composite that
-        :meth:`surface` returns (the old one is shown until then).
+        :meth:`surface` returns (the old one is shown until then; with one stripe the
+        composite is drawn onto directly).
 
         New values of the same field (once per AI tick) come in stripes when ``stripes`` > 1
         (the game on a large level, where composing the region costs a frame ~10 ms, a stripe
@@ -149,7 +150,9 @@ class StaticLayers:
         for every other (measured: 13 ms at 10^6 cells).
         """
         if at_once or self._next is None or self._next[0] is not layer:
-            self._next = (layer, self._blank("composite-next"), 0)
+            # without stripes the composite itself is the one surface drawn onto (no copy)
+            spare = self._blank("composite-next" if self.stripes > 1 else "composite")
+            self._next = (layer, spare, 0)
         _, spare, stripe = self._next
         done = self.stripes if at_once else stripe + 1
         width, height = spare.get_size()
@@ -170,7 +173,8 @@ class StaticLayers:
             self._next = (layer, spare, done)
             return
         composite = self._blank("composite")
-        composite.blit(spare, (0, 0))
+        if composite is not spare:
+            composite.blit(spare, (0, 0))
         self._composite, self._next = composite, None
         self._composite_key, self._layer = (id(layer) if layer is not None else None, show_mesh), layer
 
