@@ -24,6 +24,8 @@ KEY_HELP: tuple[tuple[str, str], ...] = (
     ("F", "take down the guard in reach (leaves a corpse)"),
     ("R", "toggle rain"),
     ("Space", "pause"),
+    ("V", "sound on / off"),
+    ("[ ]", "volume down / up"),
     ("wheel / + -", "zoom (the camera follows you)"),
     ("O / Tab", "next field overlay (none, I, C, N, P, K, ...)"),
     ("M", "show the grid / navmesh"),

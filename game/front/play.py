@@ -41,6 +41,7 @@ from game.errors import FrontError
 from game.front.keys import KEY_HELP, MODE_ORDER
 from navmesh.level import bundled_level_names
 from game.front.screens import Panel
+from game.front.sound import SoundBoard
 from game.objectives import Objectives
 from game.record import HUMAN, QUESTIONS, Recording
 from game.scene import OVERLAYS, Scene, SceneBuilder, overlay_key
@@ -136,6 +137,7 @@ class PlayGame(FrameLoop):
         self._distances: DistanceWorker | None = None
         #: the game ended, recording, before the distance searches were done: store then
         self._store_when_ready = False
+        self.sound = SoundBoard()
         self._load(settings.level, settings.guards)
         _freeze_heap()
 
@@ -182,6 +184,8 @@ class PlayGame(FrameLoop):
             world.player_input = (0.0, 0.0)  # the keyboard drives; the policy never runs
         self.goal = Objectives.of(world.level)
         self.rings = NoiseRings()
+        if hasattr(self, "sound"):
+            self.sound.reset()
         self.state = "ready" if self.autopilot is None else "playing"
         self.outcome = ""
         self.answers: dict[str, int] = {}
@@ -256,6 +260,7 @@ class PlayGame(FrameLoop):
             self.outcome = "caught"
         else:
             self.outcome = "survived" if not self.goal.has_goal else "time up"
+        self.sound.game_over(self.outcome)
         if self.recording is not None and self.settings.questions:
             self.state = "questions"
         elif self.world.m.distances_ready():
@@ -328,6 +333,11 @@ class PlayGame(FrameLoop):
             self._mechanic("take_down")
         elif key == pygame.K_r:
             self._mechanic("toggle_rain")
+        elif key == pygame.K_v:
+            self.flash("sound off" if self.sound.toggle_mute() else "sound on", GOOD)
+        elif key in (pygame.K_LEFTBRACKET, pygame.K_RIGHTBRACKET):
+            step = 0.1 if key == pygame.K_RIGHTBRACKET else -0.1
+            self.flash(f"volume {round(100 * self.sound.change_volume(step))} %", GOOD)
 
     def _answer(self, key: int) -> None:
         """Questionnaire keys: 1-5 rate the current question, Esc / Enter skip the rest."""
@@ -456,7 +466,7 @@ class PlayGame(FrameLoop):
             info.append("REC")
         return DrawOptions(
             show_mesh=self.show_mesh, show_plans=self.show_plans,
-            paused=self.paused and self.state == "playing",
+            paused=self.paused,
             help=self.help_items(), message=message, message_color=self.message_color,
             info=info, panel=self.panel(),
             collectibles=self.goal.collectibles[~self.goal.collected],
@@ -490,7 +500,10 @@ class PlayGame(FrameLoop):
         if not self.running:
             return
         self.update(elapsed)
-        self.draw()
+        scene = self.draw()
+        if self.state == "playing" and not self.paused:
+            self.sound.observe(self.world, scene.detected, scene.phase,
+                               [g.awareness for g in scene.guards])
         pygame.display.flip()
         spare = WORK_AHEAD_UNTIL - (time.perf_counter() - start)
         if spare > 0 and not self.idle():
@@ -511,6 +524,7 @@ class PlayGame(FrameLoop):
         """Store the session still open (if recording) and give the frozen heap back."""
         self._close_session("quit")
         self._close_distances()
+        self.sound.close()
         gc.unfreeze()
 
     def _close_distances(self) -> None:

@@ -34,6 +34,7 @@ from .camera import MIN_FIT_SCALE, START_SCALE, ZOOM_STEP, Camera
 from .labels import place_labels
 from .layers import StaticLayers
 from .minimap import Minimap
+from .marks import awareness_fill, draw_awareness_mark, draw_phase_ring, draw_player_halo
 from .palette import (
     ATTACK_RING, BACKGROUND, BAD, EXIT_EDGE, COLLECTIBLE, CONE, CONE_EDGE, CONE_SEEING, CONE_SEEING_EDGE,
     GOOD, GUARD, GUARD_ALERT, GUARD_DOWN, HALO, MARKER, PLAN_COLORS, PLAYER, PLAYER_SPRINT,
@@ -243,8 +244,9 @@ class Renderer:
             draw_panel(surface, area, options.panel, avoid=player)
         elif options.banner:
             draw_panel(surface, area, Panel(options.banner, (options.banner_sub,)), avoid=player)
-        elif options.paused:
-            draw_panel(surface, area, Panel("PAUSED", ("Space to continue",), where="corner"))
+        if options.paused:  # over any screen: a paused ready screen must not look frozen
+            where = "corner" if options.panel is None else "bottom-left"
+            draw_panel(surface, area, Panel("PAUSED", ("Space to continue",), BAD, where=where))
 
     def _draw_cone(self, surface: pygame.Surface, guard: GuardDrawing) -> None:
         if not guard.active or len(guard.cone) < 3:
@@ -312,13 +314,10 @@ class Renderer:
         hx, hy = np.cos(guard.heading), np.sin(guard.heading)
         tip = (center[0] + hx * radius * 1.7, center[1] + hy * radius * 1.7)
         pygame.draw.line(surface, (20, 20, 20), center, tip, 2)
-        if guard.awareness is not None:  # graded perception: a meter below the guard
-            frac = max(0.0, min(1.0, guard.awareness))
-            meter = pygame.Rect(round(center[0] - radius), round(center[1] + radius + 3),
-                                round(2 * radius), 4)
-            pygame.draw.rect(surface, (40, 40, 40), meter)
-            pygame.draw.rect(surface, BAD if frac >= 1.0 else WARN,
-                             (meter.x, meter.y, round(meter.w * frac), meter.h))
+        draw_phase_ring(surface, center, radius, scene.phase)
+        fill = awareness_fill(guard.sees_player, guard.awareness, guard.state)
+        if fill is not None:
+            draw_awareness_mark(surface, self.small, self._text, center, radius, fill)
 
     def _draw_labels(self, surface: pygame.Surface, scene: Scene) -> None:
         """The behaviour labels on dark boxes, drawn after every marker and placed by
@@ -346,6 +345,7 @@ class Renderer:
         center = self.to_screen(*p.pos)
         radius = max(5.0, scene.agent_radius * s)
         color = PLAYER_SPRINT if p.sprinting else PLAYER
+        draw_player_halo(surface, center, radius)
         if p.concealed:
             pygame.draw.circle(surface, color, center, radius, 2)
         else:

@@ -73,6 +73,8 @@ def draw_panel(surface: pygame.Surface, area: pygame.Rect, panel: Panel,
     height = title.get_height() + sum(r.get_height() + 3 for r in rows) + 26
     if panel.where == "corner":
         x, y = area.right - width - 10, area.top + 10
+    elif panel.where == "bottom-left":
+        x, y = area.left + 10, area.bottom - height - 10
     else:
         x, y = area.centerx - width // 2, area.top + 10
         if avoid is not None and avoid[1] < area.centery:
