@@ -12,3 +12,10 @@ from hypothesis import settings
 settings.register_profile("ci", derandomize=True, print_blob=True)
 settings.register_profile("dev", print_blob=True)
 settings.load_profile("ci" if os.environ.get("CI") else "dev")
+
+# The game keeps the player's best results in the user's data directory: never the real one
+# from the tests (each test process gets a fresh one).
+if "STEALTHFIELD_DATA" not in os.environ:
+    import tempfile
+
+    os.environ["STEALTHFIELD_DATA"] = tempfile.mkdtemp(prefix="stealthfield-data-")

@@ -18,7 +18,7 @@ import pygame
 from .palette import BAD, HALO, WARN, Color
 
 __all__ = ["PHASE_COLORS", "awareness_fill", "draw_awareness_mark", "draw_phase_ring",
-           "draw_player_halo"]
+           "draw_player_halo", "mark_font"]
 
 PHASE_COLORS: dict[str, Color] = {
     "suspicious": WARN, "alert": BAD, "search": (255, 140, 40), "caution": (250, 235, 190),
@@ -43,12 +43,22 @@ def awareness_fill(sees_player: bool, awareness: float | None, state: str) -> fl
     return None
 
 
+_FONTS: dict[int, pygame.font.Font] = {}
+
+
+def mark_font() -> pygame.font.Font:
+    """The mark's glyph font (made once, after pygame's font module is up)."""
+    if 26 not in _FONTS:
+        _FONTS[26] = pygame.font.Font(None, 26)
+    return _FONTS[26]
+
+
 def draw_awareness_mark(surface: pygame.Surface, font: pygame.font.Font,
                         text: Callable[[str, pygame.font.Font, Color], pygame.Surface],
                         center: tuple[float, float], radius: float, fill: float) -> None:
     """The mark above a guard at ``center``: a box filled to ``fill`` from the bottom, with
     "?" (filling) or "!" (full) on it."""
-    w, h = 14, 18
+    w, h = 18, 24
     box = pygame.Rect(round(center[0] - w / 2), round(center[1] - radius - h - 6), w, h)
     pygame.draw.rect(surface, HALO, box.inflate(4, 4), border_radius=4)
     level = round(h * fill)

@@ -42,6 +42,7 @@ from game.front.keys import KEY_HELP, MODE_ORDER
 from navmesh.level import bundled_level_names
 from game.front.screens import Panel
 from game.front.sound import SoundBoard
+from game.front.best import BestResults
 from game.objectives import Objectives
 from game.record import HUMAN, QUESTIONS, Recording
 from game.scene import OVERLAYS, Scene, SceneBuilder, overlay_key
@@ -138,6 +139,7 @@ class PlayGame(FrameLoop):
         #: the game ended, recording, before the distance searches were done: store then
         self._store_when_ready = False
         self.sound = SoundBoard()
+        self.best = BestResults()
         self._load(settings.level, settings.guards)
         _freeze_heap()
 
@@ -261,6 +263,11 @@ class PlayGame(FrameLoop):
         else:
             self.outcome = "survived" if not self.goal.has_goal else "time up"
         self.sound.game_over(self.outcome)
+        if self.autopilot is None:  # the player's own game: keep it if it is the best yet
+            result = {"outcome": self.outcome, "time": round(self.world.t, 2),
+                      "stars": int(self.goal.collected.sum())}
+            if self.best.offer(self.level.name, self.mode, result):
+                self.flash("a new best result", GOOD)
         if self.recording is not None and self.settings.questions:
             self.state = "questions"
         elif self.world.m.distances_ready():
@@ -609,11 +616,13 @@ def cmd_play(args: argparse.Namespace, on_session: SessionSink | None = None) ->
         from game.front.chooser import LevelChooser
 
         pygame.display.set_caption("Stealthfield")
-        chooser = LevelChooser(pygame.display.set_mode((960, 640)), bundled_level_names())
+        chooser = LevelChooser(pygame.display.set_mode((960, 780)), bundled_level_names(),
+                               mode=args.guards)
         level = chooser.run()
         if level is None:
             pygame.display.quit()
             return 0
+        args.guards = chooser.mode
     settings = PlaySettings(
         level=level, guards=args.guards, abstraction=args.abstraction,
         scenario=args.scenario, seed=args.seed,

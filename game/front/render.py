@@ -34,7 +34,9 @@ from .camera import MIN_FIT_SCALE, START_SCALE, ZOOM_STEP, Camera
 from .labels import place_labels
 from .layers import StaticLayers
 from .minimap import Minimap
-from .marks import awareness_fill, draw_awareness_mark, draw_phase_ring, draw_player_halo
+from .marks import (
+    awareness_fill, draw_awareness_mark, draw_phase_ring, draw_player_halo, mark_font,
+)
 from .palette import (
     ATTACK_RING, BACKGROUND, BAD, EXIT_EDGE, COLLECTIBLE, CONE, CONE_EDGE, CONE_SEEING, CONE_SEEING_EDGE,
     GOOD, GUARD, GUARD_ALERT, GUARD_DOWN, HALO, MARKER, PLAN_COLORS, PLAYER, PLAYER_SPRINT,
@@ -317,7 +319,7 @@ class Renderer:
         draw_phase_ring(surface, center, radius, scene.phase)
         fill = awareness_fill(guard.sees_player, guard.awareness, guard.state)
         if fill is not None:
-            draw_awareness_mark(surface, self.small, self._text, center, radius, fill)
+            draw_awareness_mark(surface, mark_font(), self._text, center, radius, fill)
 
     def _draw_labels(self, surface: pygame.Surface, scene: Scene) -> None:
         """The behaviour labels on dark boxes, drawn after every marker and placed by
@@ -329,7 +331,8 @@ class Renderer:
             return
         texts = [self._text(f"{g.state} · {g.role}" if g.role else g.state, self.small, TEXT)
                  for g in shown]
-        anchors = [(*self.to_screen(*g.pos), radius) for g in shown]
+        # the awareness mark sits above a guard: a label keeps clear of it too
+        anchors = [(*self.to_screen(*g.pos), radius + 30) for g in shown]
         px, py = self.to_screen(*scene.player.pos)
         pr = radius + 4  # the red "seen" ring
         spots = place_labels(anchors, [(t.get_width() + 6, t.get_height() + 2) for t in texts],

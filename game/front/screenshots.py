@@ -19,6 +19,9 @@ from collections.abc import Callable
 from pathlib import Path
 
 os.environ.setdefault("SDL_VIDEODRIVER", "dummy")
+os.environ.setdefault("SDL_AUDIODRIVER", "dummy")
+# the shots' games must not touch the user's best results (the chooser shot writes its own)
+os.environ["STEALTHFIELD_DATA"] = tempfile.mkdtemp(prefix="stealthfield-shots-")
 
 from game.front.play import PlayGame, PlaySettings
 from game.front.render import pygame, save_screenshot
@@ -105,14 +108,40 @@ def _large() -> PlayGame:
 
 
 def _chooser() -> pygame.Surface:
+    """The chooser with the player's best results on two levels (a fresh data directory)."""
+    from game.front.best import BestResults
     from game.front.chooser import LevelChooser
     from navmesh.level import bundled_level_names
 
+    best = BestResults(Path(tempfile.mkdtemp()) / "best.json")
+    best.offer("maze", "pf", {"outcome": "survived", "time": 60.0, "stars": 0})
+    best.offer("miami", "pf", {"outcome": "caught", "time": 41.3, "stars": 0})
     screen = pygame.display.set_mode(SIZE)
-    chooser = LevelChooser(screen, bundled_level_names())
-    chooser.index = 2
+    chooser = LevelChooser(screen, bundled_level_names(), best=best)
+    chooser.index = 3
     chooser.run(frames=1)
     return screen
+
+
+def _awareness() -> PlayGame:
+    """Graded perception on: a guard's "?" fills before it sees the player (then "!")."""
+    game = _game("miami", 0, autopilot="maxmin", overrides=("awareness.enabled=true",
+                                                             "alert.enabled=true"))
+    for _ in range(3000):
+        game.run(1)
+        scene = game.scene
+        if scene is not None and not scene.detected and any(
+                g.awareness is not None and 0.45 < g.awareness < 0.9 for g in scene.guards):
+            break
+    return game
+
+
+def _paused() -> PlayGame:
+    """Space on the ready screen: the PAUSED sign over the ready panel."""
+    game = _game("miami", 1)
+    game.paused = True
+    game.run(1)
+    return game
 
 
 def _replay() -> pygame.Surface:
@@ -168,6 +197,8 @@ SHOTS: dict[str, Callable[[], PlayGame | pygame.Surface]] = {
     "play-miami-noise-rain.png": _noise_rain,
     "play-building-camera.png": _large,
     "play-chooser.png": _chooser,
+    "play-miami-awareness.png": _awareness,
+    "play-miami-paused.png": _paused,
     "replay-miami.png": _replay,
     "replay-building-camera.png": _replay_large,
 }

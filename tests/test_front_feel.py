@@ -1,0 +1,183 @@
+"""Game feel (issue 25): sounds per event kind, silence without an audio device, the
+awareness mark, the paused sign over every screen, the chooser's cards and best results."""
+
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+from collections import Counter
+from pathlib import Path
+
+import pytest
+
+os.environ.setdefault("SDL_VIDEODRIVER", "dummy")
+os.environ.setdefault("SDL_AUDIODRIVER", "dummy")
+
+from game.front import render as render_module
+from game.front.best import BestResults
+from game.front.chooser import LevelChooser, thumbnail
+from game.front.palette import FLOOR
+from game.front.play import PlayGame, PlaySettings
+from game.front.render import pygame
+from game.front.sound import KINDS, SoundBoard
+
+SIZE = (640, 520)
+
+
+class _CountingSound:
+    """Stands in for a mixer Sound: counts the mixer calls made for one kind."""
+
+    def __init__(self, kind: str, calls: Counter[str]) -> None:
+        self.kind, self.calls = kind, calls
+
+    def play(self, loops: int = 0) -> None:
+        self.calls[self.kind] += 1
+
+    def set_volume(self, volume: float) -> None:
+        pass
+
+
+def _count_mixer_calls(board: SoundBoard) -> Counter[str]:
+    assert board.available, "the dummy audio driver opens a mixer"
+    calls: Counter[str] = Counter()
+    board._sounds = {kind: _CountingSound(kind, calls) for kind in KINDS}  # type: ignore[misc]
+    return calls
+
+
+def test_a_scripted_session_plays_every_sound_event() -> None:
+    game = PlayGame(PlaySettings("miami", autopilot="maxmin", overrides=(
+        "awareness.enabled=true", "alert.enabled=true", "world.duration=30")),
+        lockstep=True, size=SIZE)
+    calls = _count_mixer_calls(game.sound)
+    world = game.world
+    try:
+        game.run(120)  # walking
+        world.sprinting = True
+        game.run(120)
+        world.toggle_rain()
+        x, y = world.player.pos
+        world.throw_decoy(x + 2.0, y + 1.0)
+        game.run(90)
+        world.down_guard(0)
+        game.run(90)
+        while not world.done:
+            game.run(60)
+        game.run(2)
+    finally:
+        game.close()
+    played = game.sound.played
+    for kind in ("step", "step_sprint", "rain", "decoy_landed", "takedown", "suspicion",
+                 "sighting", "phase"):
+        assert played[kind] >= 1, (kind, dict(played))
+        assert calls[kind] == played[kind], (kind, dict(calls), dict(played))
+    assert played["win"] + played["lose"] == 1 == calls["win"] + calls["lose"]
+
+
+def test_mute_stops_the_mixer_calls_but_not_the_count() -> None:
+    pygame.display.init()
+    board = SoundBoard()
+    calls = _count_mixer_calls(board)
+    assert board.toggle_mute() is True
+    board.play("sighting")
+    assert board.played["sighting"] == 1 and calls["sighting"] == 0
+    board.toggle_mute()
+    board.play("sighting")
+    assert calls["sighting"] == 1
+    assert board.change_volume(+1.0) == 1.0 and board.change_volume(-2.0) == 0.0
+
+
+def test_without_an_audio_device_the_game_plays_silently(tmp_path: Path) -> None:
+    code = ("from game.front.play import PlayGame, PlaySettings\n"
+            "g = PlayGame(PlaySettings('miami', autopilot='maxmin'), lockstep=True, size=(480, 400))\n"
+            "g.run(200)\n"
+            "assert not g.sound.available\n"
+            "assert g.sound.played['step'] > 0\n"
+            "g.close()\nprint('ok', g.world.step_index)\n")
+    env = dict(os.environ, SDL_AUDIODRIVER="no-such-audio-device", SDL_VIDEODRIVER="dummy",
+               STEALTHFIELD_DATA=str(tmp_path))
+    result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                            env=env, timeout=120)
+    assert result.returncode == 0, result.stderr
+    assert result.stdout.split()[-2:] == ["ok", "200"]
+    assert "Traceback" not in result.stderr and "error" not in result.stderr.lower()
+
+
+def test_the_paused_sign_shows_over_the_ready_screen(monkeypatch: pytest.MonkeyPatch) -> None:
+    titles: list[str] = []
+    real = render_module.draw_panel
+
+    def spy(surface, area, panel, avoid=None):  # type: ignore[no-untyped-def]
+        titles.append(panel.title)
+        return real(surface, area, panel, avoid)
+
+    monkeypatch.setattr(render_module, "draw_panel", spy)
+    game = PlayGame(PlaySettings("miami"), lockstep=True, size=SIZE)
+    try:
+        game.run(1)
+        assert game.state == "ready" and "PAUSED" not in titles
+        game._key(pygame.K_SPACE)
+        titles.clear()
+        game.run(1)
+        assert game.state == "ready" and titles == ["miami: ready", "PAUSED"]
+    finally:
+        game.close()
+
+
+def test_a_human_game_keeps_its_best_result_and_a_worse_one_does_not_replace_it(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setenv("STEALTHFIELD_DATA", str(tmp_path))
+    game = PlayGame(PlaySettings("miami", overrides=("world.duration=2",)), lockstep=True,
+                    size=SIZE)
+    try:
+        game.start()
+        while not game.world.done:
+            game.run(30)
+        game.run(1)
+    finally:
+        game.close()
+    saved = json.loads((tmp_path / "best.json").read_text())
+    assert saved["miami"]["pf"]["outcome"] == "survived"
+    best = BestResults(tmp_path / "best.json")
+    assert not best.offer("miami", "pf", {"outcome": "caught", "time": 1.0, "stars": 0})
+    assert best.offer("miami", "pf", {"outcome": "won", "time": 1.0, "stars": 0})
+
+
+def test_an_unreadable_best_file_is_never_overwritten(tmp_path: Path,
+                                                      capsys: pytest.CaptureFixture[str]) -> None:
+    path = tmp_path / "best.json"
+    path.write_text("{not json")
+    best = BestResults(path)
+    assert not best.offer("maze", "pf", {"outcome": "won", "time": 3.0, "stars": 0})
+    assert path.read_text() == "{not json"
+    assert capsys.readouterr().err.count("\n") == 1
+
+
+def test_the_chooser_shows_cards_changes_guards_and_reads_best_results(tmp_path: Path) -> None:
+    pygame.display.init()
+    best = BestResults(tmp_path / "best.json")
+    best.offer("maze", "fsm", {"outcome": "survived", "time": 60.0, "stars": 0})
+    screen = pygame.display.set_mode((800, 700))
+    chooser = LevelChooser(screen, ["maze", "miami"], best=best)
+    chooser.handle(pygame.event.Event(pygame.KEYDOWN, key=pygame.K_RIGHT))
+    chooser.handle(pygame.event.Event(pygame.KEYDOWN, key=pygame.K_RIGHT))
+    assert chooser.mode == "fsm"
+    assert best.best("maze", chooser.mode) is not None and best.best("miami", "fsm") is None
+    chooser.handle(pygame.event.Event(pygame.KEYDOWN, key=pygame.K_DOWN))
+    chooser.handle(pygame.event.Event(pygame.KEYDOWN, key=pygame.K_RETURN))
+    assert chooser.run(frames=1) == "miami"
+    assert [card.goal for card in chooser.cards] == ["survive until the time is up"] * 2
+    picture = chooser.cards[0].picture
+    floor = sum(picture.get_at((x, y))[:3] == FLOOR
+                for x in range(0, picture.get_width(), 4) for y in range(0, picture.get_height(), 4))
+    assert floor > 100
+
+
+def test_a_level_with_an_exit_says_so_on_its_card() -> None:
+    from game.front.chooser import LevelCard
+
+    pygame.display.init()
+    heist = Path(__file__).resolve().parents[1] / "examples" / "heist.json"
+    card = LevelCard(str(heist))
+    assert "reach the exit" in card.goal
