@@ -29,20 +29,15 @@ from __future__ import annotations
 import time
 import weakref
 from collections import deque
-from collections.abc import Generator, Sequence
+from collections.abc import Sequence
 from functools import cached_property
 from typing import NamedTuple
 
 import numpy as np
 from scipy import sparse
 
-from navmesh.graph import (
-    NodeGraph,
-    RowCache,
-    falloff_depth,
-    finish_search,
-    hop_ball_pairs,
-)
+from navmesh.distances import RowCache, SlicedSearch
+from navmesh.graph import NodeGraph, falloff_depth, hop_ball_pairs
 
 from .params import PFParams
 from .view import WorldView
@@ -86,7 +81,7 @@ class FieldMatrices:
         #: nodes ("C"), the player's node while seen ("I") — and the one being searched
         #: ahead (:meth:`warm`)
         self._ahead: deque[tuple[str, int]] = deque()
-        self._warming: tuple[str, int, Generator[None, None, tuple[np.ndarray, np.ndarray]]] | None = None
+        self._warming: tuple[str, int, SlicedSearch] | None = None
         if not graph.dense:
             graph.hop_ball(0, 0)  # the searches' neighbour table, built now rather than mid-game
 
@@ -112,13 +107,11 @@ class FieldMatrices:
                     return
                 which, node = self._ahead.popleft()
                 depth = self._gamma_depth(which)[1]
-                self._warming = (which, node, self.graph.hop_ball_search(node, depth))
+                self._warming = (which, node, self.graph.hop_search(node, depth))
             which, node, search = self._warming
-            try:
-                next(search)
-            except StopIteration as done:
+            if search.update(1):
                 self._warming = None
-                inside, hops = done.value
+                inside, hops = search.finish()
                 self._rows.get(("ball", which, node),
                                lambda: self._ball_values(which, inside, hops))
 
@@ -142,7 +135,7 @@ class FieldMatrices:
             warming = self._warming
             if warming is not None and warming[:2] == (which, node):
                 self._warming = None  # being searched ahead: finish that search
-                return self._ball_values(which, *finish_search(warming[2]))
+                return self._ball_values(which, *warming[2].finish())
             return self._search_ball(which, node)
 
         inside, values = self._rows.get(("ball", which, node), make)
