@@ -25,6 +25,7 @@ from .fields import (
     sighting_node,
 )
 from .params import PFParams
+from .prefetch import Prefetch
 from .view import GuardAI, WorldView
 
 
@@ -72,6 +73,8 @@ class PotentialFieldGuards(GuardAI):
         """A fresh field on ``graph``; the graph's matrices are reused from the cache."""
         self.graph, self.rng, self.n_guards = graph, rng, n_guards
         self.field = CompositeField(graph, self.config)
+        #: the balls this team will read soon, searched in the frames' spare time
+        self.prefetch = Prefetch(self.field.spreads)
         self._last: list[_Decision | None] = [None] * n_guards
         #: explain(i)'s answer for the decision it was made from (same dict until the next)
         self._explained: dict[int, tuple[_Decision, dict[str, Any]]] = {}
@@ -101,10 +104,10 @@ class PotentialFieldGuards(GuardAI):
         own = self._personal[i] if 0 <= i < len(self._personal) else None
         personal = None if own is None else own[0]
         choice = field.select(node, self.rng, teammates, recent, personal)
-        field.matrices.anticipate(choice.winner)  # the guard's next node: its deposit ahead
+        self.prefetch.expect(choice.winner)  # the guard's next node: its deposit ahead
         seen = sighting_node(view)
         if seen is not None:  # the next tick spreads information from here (if still seen)
-            field.matrices.anticipate(seen, "I")
+            self.prefetch.expect(seen, "I")
         self._last[i] = _Decision(
             t=float(view.t),
             node=node,
@@ -225,8 +228,8 @@ class PotentialFieldGuards(GuardAI):
         return self.field.fields()
 
     def prepare(self, budget: float) -> None:
-        """The guards' next nodes' spreads ahead, for about ``budget`` s (:meth:`FieldMatrices.warm`)."""
-        self.field.matrices.warm(budget)
+        """The guards' next nodes' spreads ahead, for about ``budget`` s (:meth:`Prefetch.run`)."""
+        self.prefetch.run(budget)
 
     def fields_later(self) -> tuple[Hashable, Callable[[], dict[str, np.ndarray]]]:
         """The field's state now (:meth:`CompositeField.snapshot`): nothing computed until called."""

@@ -224,3 +224,21 @@ class PlayerPolicy(ABC):
     def actions(self, view: WorldView) -> Sequence[Action]:
         """Actions to take at this decision (sprint, throw, ...); none by default."""
         return ()
+
+
+# ---------------------------------------------------------------------------- reading a view
+
+
+def active_guard_nodes(view: WorldView) -> np.ndarray:
+    """Nodes of the guards still in play (a guard taken down deposits no confidence)."""
+    nodes = np.asarray(view.guard_nodes, dtype=np.intp)
+    if view.guard_active is None:
+        return nodes
+    return nodes[np.asarray(view.guard_active, dtype=bool)]
+
+
+def sighting_node(view: WorldView) -> int | None:
+    """The player's node if a guard sees it now, else ``view.sighting`` (None: not seen)."""
+    if view.seen_by:
+        return int(view.player_node)
+    return None if view.sighting is None else int(view.sighting)

@@ -27,7 +27,7 @@ import numpy as np
 import _paths  # noqa: E402,F401  (project importable, this folder unshadowed)
 
 from ai import make_guard_ai, make_player_policy  # noqa: E402
-from ai.fields import _MATRIX_CACHE  # noqa: E402
+from ai.field_matrices import _MATRIX_CACHE  # noqa: E402
 from ai.view import WorldView  # noqa: E402
 from navmesh.graph import NodeGraph  # noqa: E402
 

@@ -23,7 +23,7 @@ from navmesh.level import cached_level
 
 from .config import Config
 from .observations import OBS_BOUND, Observer
-from .trial import TrialSpec, trial_rngs
+from .trial import TrialSpec, make_world
 from .world import World
 
 __all__ = ["ExternalGuards", "ExternalPlayer", "GRID_ACTIONS", "Match", "PARTITION_ACTIONS",
@@ -182,9 +182,8 @@ class Match:
         spec = TrialSpec(level=self.level.name, abstraction=self.abstraction,
                          guards=self.guard_mode or "external", player="external",
                          scenario=self.scenario, seed=seed)
-        return World(self.level, self.abstraction, guard_ai, self.player, config=self.config,
-                     scenario=self.scenario, rngs=trial_rngs(spec, self.level.name),
-                     graph=self.graph)
+        return make_world(spec, self.config, level=self.level,
+                          controllers=(guard_ai, self.player), graph=self.graph)
 
     def reset(self, seed: int | None, fallback: np.random.Generator) -> dict[str, Any]:
         """Start the episode of trial seed ``seed`` (or the next one); return its info."""

@@ -22,7 +22,7 @@ from typing import Any
 
 from .config import Config
 from .trace import attach_trace
-from .trial import TrialSpec, make_world
+from .trial import TrialSpec, identity_row, make_world
 from .world import World
 
 __all__ = ["HUMAN", "QUESTIONS", "Recording", "policy_row", "trial_row"]
@@ -47,15 +47,8 @@ def trial_row(world: World, spec: TrialSpec, config: Config, *, key: str,
     """
     return {
         "key": key,
-        "level": world.level.name,
+        **identity_row(spec, world.level.name),
         "level_ref": spec.level,
-        "abstraction": spec.abstraction,
-        "guards": spec.guards,
-        "player": spec.player,
-        "scenario": spec.scenario,
-        "seed": spec.seed,
-        "root_seed": spec.root_seed,
-        "overrides": dict(spec.overrides),
         "config_hash": config.hash(),
         "metrics": {**world.metrics(), **dict(extra or {})},
         "visits": world.m.visits.tolist(),

@@ -18,7 +18,8 @@ import numpy as np
 
 from ai import make_guard_ai, make_player_policy
 from ai.stimuli import load_stimulus
-from navmesh.level import cached_level
+from ai.view import GuardAI, PlayerPolicy
+from navmesh.level import Level, cached_level
 
 from .config import Config
 from .trace import attach_trace
@@ -86,22 +87,51 @@ def trial_rngs(spec: TrialSpec, level_name: str) -> Generators:
     return spawn, guards, player
 
 
-def make_world(spec: TrialSpec, config: Config | None = None, **world_kwargs: Any) -> World:
-    """Build the world of a trial (level and graph are cached per process)."""
+def make_world(
+    spec: TrialSpec, config: Config | None = None, *, level: Level | None = None,
+    controllers: tuple[GuardAI, PlayerPolicy | None] | None = None, **world_kwargs: Any,
+) -> World:
+    """Build the world of a trial: the one place a :class:`World` is constructed.
+
+    Level and graph are cached per process. ``level`` is the level already loaded (else
+    ``spec.level`` is loaded); ``controllers`` are the guard AI and player policy to run
+    (an environment's external controllers, the mechanics experiment's players; ``None``
+    for no player policy), else the spec's are made. The generators always derive from the
+    spec (:func:`trial_rngs`); ``world_kwargs`` go to :class:`World` (``graph``,
+    ``interactive``, ``stimuli``).
+    """
     config = config or Config.load(spec.settings)
     if spec.stimuli:  # first: loading a plugin registers the zone kinds its level may use
         world_kwargs.setdefault("stimuli", [load_stimulus(s) for s in spec.stimuli])
-    level = cached_level(spec.level)
+    if level is None:
+        level = cached_level(spec.level)
+    if controllers is None:
+        controllers = (make_guard_ai(spec.guards, config.section(spec.guards)),
+                       make_player_policy(spec.player, player_params(config, spec.scenario)))
+    guard_ai, player = controllers
     return World(
         level,
         spec.abstraction,
-        make_guard_ai(spec.guards, config.section(spec.guards)),
-        make_player_policy(spec.player, player_params(config, spec.scenario)),
+        guard_ai,
+        player,
         config=config,
         scenario=spec.scenario,
         rngs=trial_rngs(spec, level.name),
         **world_kwargs,
     )
+
+
+def identity_row(spec: TrialSpec, level_name: str | None = None) -> dict[str, Any]:
+    """The identity part of a trial's row, built from the spec in this one place: the
+    spec's fields (``stimuli`` and ``factors`` only when set), ``level`` the level's name
+    (``level_name``; the spec's level when it is not known, e.g. a trial that failed)."""
+    return {
+        **{k: v for k, v in asdict(spec).items() if k not in ("overrides", "stimuli", "factors")},
+        **({"stimuli": list(spec.stimuli)} if spec.stimuli else {}),
+        **({"factors": dict(spec.factors)} if spec.factors else {}),
+        "level": spec.level if level_name is None else level_name,
+        "overrides": dict(spec.overrides),
+    }
 
 
 def player_params(config: Config, scenario: str) -> dict[str, Any]:
@@ -130,11 +160,7 @@ def run_trial(
     if writer is not None:
         writer.finish(world)
     return {
-        **{k: v for k, v in asdict(spec).items() if k not in ("overrides", "stimuli", "factors")},
-        **({"stimuli": list(spec.stimuli)} if spec.stimuli else {}),
-        **({"factors": dict(spec.factors)} if spec.factors else {}),
-        "level": world.level.name,
-        "overrides": dict(spec.overrides),
+        **identity_row(spec, world.level.name),
         "config_hash": config.hash(),
         "config": config.as_dict(),
         "metrics": metrics,
@@ -160,4 +186,5 @@ def sim_document(row: Mapping[str, Any]) -> dict[str, Any]:
     }
 
 
-__all__: Sequence[str] = ["TrialSpec", "run_trial", "make_world", "trial_rngs", "sim_document"]
+__all__: Sequence[str] = ["TrialSpec", "identity_row", "run_trial", "make_world", "trial_rngs",
+                          "sim_document"]

@@ -278,6 +278,10 @@ def _cmd_report(args: argparse.Namespace) -> int:
 
 
 def _cmd_mechanics(args: argparse.Namespace) -> int:
+    if args.stimulus:
+        from .stimulus_effect import cmd_stimulus_effect
+
+        return cmd_stimulus_effect(args)
     from .mechanics_run import cmd_mechanics
 
     return cmd_mechanics(args)

@@ -21,7 +21,7 @@ import traceback
 from collections.abc import Callable, Sequence
 from typing import Any
 
-from game.trial import TrialSpec, run_trial
+from game.trial import TrialSpec, identity_row, run_trial
 
 from .errors import SweepError, UserError
 
@@ -36,12 +36,8 @@ def run_one(spec: TrialSpec) -> dict[str, Any]:
     try:
         row = run_trial(spec)
     except Exception as error:
-        row = {
-            "level": spec.level, "abstraction": spec.abstraction, "guards": spec.guards,
-            "player": spec.player, "scenario": spec.scenario, "seed": spec.seed,
-            "root_seed": spec.root_seed, "overrides": dict(spec.overrides),
-            "factors": dict(spec.factors), "error": f"{type(error).__name__}: {error}\n{traceback.format_exc(limit=-8)}"[:8000],
-        }
+        row = {**identity_row(spec),
+               "error": f"{type(error).__name__}: {error}\n{traceback.format_exc(limit=-8)}"[:8000]}
     row["key"] = spec.key
     row["level_ref"] = spec.level
     return row

@@ -27,78 +27,23 @@ seed and measure, both arms) — run by :mod:`headless.mechanics_run`; this modu
 from __future__ import annotations
 
 import math
-from collections.abc import Callable, Mapping
+from collections.abc import Callable
 from typing import Any
 
 import numpy as np
 
-from ai import make_guard_ai
 from ai.stimuli import footstep_rule
-from ai.view import Action, Event, PlayerPolicy, WorldView
-from game.config import Config
-from game.trial import TrialSpec, trial_rngs
+from ai.view import Action, Event
 from game.world import World
-from navmesh.graph import NodeGraph
-from navmesh.level import cached_level
 
 from .mechanics_ai import AI_EXPECTED, AI_MECHANICS
+from .mechanics_world import BLIND, Measures, WanderPlayer, active_guard_nodes, make_world, run_until
 
-#: guards cannot see and the player cannot be hurt: only the mechanic informs the guards
-BLIND = {"world.view_range": 0.0, "world.attack_range": 0.0, "world.player_hp": 1.0e6}
 BOOTSTRAP = 2000
-
-
-# ---------------------------------------------------------------------------- helpers
-
-
-class WanderPlayer(PlayerPolicy):
-    """Walks at random without turning back, ignoring the guards.
-
-    Its path depends only on its generator, so both arms of a pair walk the same path.
-    """
-
-    policy = "wander"
-
-    def reset(self, graph: NodeGraph, rng: np.random.Generator) -> None:
-        self.graph, self.rng, self.previous = graph, rng, -1
-
-    def decide(self, view: WorldView) -> int:
-        node = int(view.player_node)
-        options = [int(v) for v in self.graph.neighbors[node] if v != self.previous]
-        options = options or [int(v) for v in self.graph.neighbors[node]] or [node]
-        self.previous = node
-        return options[int(self.rng.integers(len(options)))]
-
-
-def make_world(
-    level: str, abstraction: str, seed: int, overrides: Mapping[str, Any], *,
-    player: PlayerPolicy | None = None, tag: str = "mechanics",
-) -> World:
-    """A PF world of the ``fixed`` scenario whose generators depend on (level, seed, tag) only."""
-    config = Config.load({k: str(v).lower() if isinstance(v, bool) else str(v)
-                          for k, v in overrides.items()})
-    lvl = cached_level(level)
-    spec = TrialSpec(level, abstraction, "pf", tag, "fixed", seed)
-    return World(lvl, abstraction, make_guard_ai("pf", config.section("pf")), player,
-                 config=config, scenario="fixed", rngs=trial_rngs(spec, lvl.name))
-
-
-def run_until(world: World, t_end: float, each_step: Callable[[World], None] | None = None) -> None:
-    """Step ``world`` until ``t_end`` seconds (calling ``each_step`` after every step)."""
-    while not world.done and world.t < t_end - 1e-9:
-        world.step()
-        if each_step is not None:
-            each_step(world)
-
-
-def active_guard_nodes(world: World) -> list[int]:
-    return [g.node for g in world.guards if g.active]
 
 
 # ---------------------------------------------------------------------------- the mechanics
 # Each returns {measure: {arm: value}} for one seed; arms "on", "control", optionally "baseline".
-
-Measures = dict[str, dict[str, float]]
 
 
 def decoy(level: str, abstraction: str, seed: int) -> Measures:

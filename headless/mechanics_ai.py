@@ -23,7 +23,7 @@ from ai import make_player_policy
 from game.config import Config
 from game.trial import player_params
 
-Measures = dict[str, dict[str, float]]
+from .mechanics_world import BLIND, Measures, active_guard_nodes, make_world, run_until
 HP = {"world.player_hp": 1.0e6}
 
 
@@ -31,8 +31,6 @@ def _run(level: str, abstraction: str, seed: int, overrides: dict[str, Any], *,
          maxmin: bool, horizon: float, placed_in: str = "",
          stop_on_detection: bool = False) -> Any:
     """One PF world of the mechanics experiment, run to ``horizon`` seconds."""
-    from .mechanics import make_world, run_until  # the shared helpers (imports this module)
-
     player = (make_player_policy("maxmin", player_params(Config.load(), "fixed"))
               if maxmin else None)
     world = make_world(level, abstraction, seed, overrides, player=player,
@@ -86,8 +84,6 @@ def _captures(switch: str) -> Callable[[str, str, int], Measures]:
 def missing(level: str, abstraction: str, seed: int) -> Measures:
     """Guard 0 taken down at t = 0, no corpse rule, blind guards: the nearest active
     guard's mean hop distance to its last node in 10–30 s, radio (missing report) vs none."""
-    from .mechanics import BLIND, active_guard_nodes, make_world, run_until
-
     out = {}
     for arm, on in (("on", True), ("control", False)):
         world = make_world(level, abstraction, seed, {**BLIND, "radio.enabled": on})

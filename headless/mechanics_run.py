@@ -233,17 +233,23 @@ def write_results(out: Path, rows: Sequence[Row], summaries: Sequence[Summary], 
         writer.writerows(rows)
 
 
-def cmd_mechanics(args: argparse.Namespace) -> int:
-    """``stealth mechanics``: run the paired experiment, write the files, print the table."""
+def refuse_arguments(args: argparse.Namespace) -> int | None:
+    """The checks of ``stealth mechanics`` with or without ``--stimulus``: 2 (after the
+    one-line message) for too few seeds, else None; a bad ``--workers`` raises."""
     if args.seeds < 2:
         print("stealth: error: --seeds: need at least 2 seeds", file=sys.stderr)
         return 2
     if args.workers is not None:
         check_workers(args.workers)
-    if args.stimulus:
-        from .stimulus_effect import cmd_stimulus_effect
+    return None
 
-        return cmd_stimulus_effect(args)
+
+def cmd_mechanics(args: argparse.Namespace) -> int:
+    """``stealth mechanics`` (without ``--stimulus``, :mod:`headless.stimulus_effect`): run
+    the paired experiment, write the files, print the table."""
+    refused = refuse_arguments(args)
+    if refused is not None:
+        return refused
     try:
         level = load_level(args.level)
     except ValueError as error:
@@ -260,4 +266,5 @@ def cmd_mechanics(args: argparse.Namespace) -> int:
     return 0
 
 
-__all__ = ["cmd_mechanics", "draw_curve", "run_jobs", "run_mechanics", "summarise"]
+__all__ = ["cmd_mechanics", "draw_curve", "refuse_arguments", "run_jobs", "run_mechanics",
+           "summarise"]

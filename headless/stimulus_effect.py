@@ -30,7 +30,7 @@ from navmesh.level import load_level
 
 from .errors import UserError
 from .mechanics import Row
-from .mechanics_run import effects_table, run_jobs, summarise, write_results
+from .mechanics_run import effects_table, refuse_arguments, run_jobs, summarise, write_results
 
 __all__ = ["check_measure", "measure_label", "plugin_measures", "run_plugin_job",
            "cmd_stimulus_effect"]
@@ -122,6 +122,9 @@ def markdown(plugins: Sequence[str], measures: Sequence[Measure], summaries: Any
 
 def cmd_stimulus_effect(args: argparse.Namespace) -> int:
     """``stealth mechanics --stimulus ...``: measure each plugin, write the files, print."""
+    refused = refuse_arguments(args)
+    if refused is not None:
+        return refused
     plugins = list(dict.fromkeys(args.stimulus))
     declared = [plugin_measures(p) for p in plugins]  # before the level: its zone kinds
     level = load_level(args.level)

@@ -6,29 +6,32 @@ distance queries. The AI works on this type only and never asks which abstractio
 running on.
 
 Distances are computed on demand, so memory grows with the level rather than its square:
-a graph of at most :data:`DENSE_MAX_NODES` nodes (every bundled level) computes its dense
-all-pairs matrices once, because that is cheapest there; a larger one answers each query
-with a search from the source — metric distances by :func:`scipy.sparse.csgraph.dijkstra`,
-hop counts by a breadth-first search ring by ring (:meth:`NodeGraph.hop_ball_search`) — and
-keeps the last rows in a cache bounded in bytes (:data:`ROW_CACHE_BYTES`). Metric queries
-run the same per-source search on the same CSR matrix either way and hop counts are exact
-integers, so every answer is bit-identical whichever path a graph takes
-(tests/test_graph_queries.py checks it).
+the graph picks one storage strategy of :mod:`navmesh.distances` when it is built — dense
+all-pairs matrices up to :data:`DENSE_MAX_NODES` nodes (every bundled level), per-source
+searches with a bounded row cache above — and delegates every query to it. Every answer is
+bit-identical whichever strategy a graph holds (tests/test_graph_queries.py checks it).
 """
 
 from __future__ import annotations
 
-from collections import OrderedDict
-from collections.abc import Callable, Generator, Hashable, Iterator, Sequence
+from collections.abc import Iterator, Sequence
 from dataclasses import dataclass, field
 from functools import cached_property, lru_cache
-from typing import TYPE_CHECKING, Any, Literal
+from typing import TYPE_CHECKING, Literal
 
 import numpy as np
 from scipy.sparse import csr_matrix
-from scipy.sparse.csgraph import connected_components, dijkstra, shortest_path
+from scipy.sparse.csgraph import connected_components
 
 from .clearance import DEFAULT_AGENT_RADIUS, clearance_for
+from .distances import (
+    ROW_CACHE_BYTES,
+    UNREACHABLE_HOPS,
+    Distances,
+    RowCache,
+    SlicedSearch,
+    distances_for,
+)
 
 if TYPE_CHECKING:
     from .level import Level
@@ -37,15 +40,13 @@ if TYPE_CHECKING:
 Abstraction = Literal["grid", "partition"]
 ABSTRACTIONS: tuple[str, ...] = ("grid", "partition")
 
-#: Hop distance used for node pairs that are not connected (or beyond a search's max_hops).
-UNREACHABLE_HOPS = np.iinfo(np.int32).max // 4
-
 #: Graphs with at most this many nodes keep dense all-pairs matrices (20 bytes × n²:
 #: 84 MB at the limit); larger ones search per source. Results are the same either way.
 DENSE_MAX_NODES = 2048
 
-#: Bytes of per-source distance rows a sparse graph keeps (least recently used go first).
-ROW_CACHE_BYTES = 256 * 2**20
+__all__ = ["ABSTRACTIONS", "DENSE_MAX_NODES", "ROW_CACHE_BYTES", "UNREACHABLE_HOPS", "Neighbours",
+           "NodeGraph", "RowCache", "SlicedSearch", "build_graph", "falloff_depth", "graph_for",
+           "hop_ball_pairs"]
 
 
 def falloff_depth(base: float, tolerance: float = 1e-12) -> int | None:
@@ -105,61 +106,6 @@ class Neighbours(Sequence[np.ndarray]):
         return cls(indptr, indices.astype(np.int64, copy=False))
 
 
-class RowCache:
-    """Least-recently-used per-key arrays, bounded by their total bytes."""
-
-    def __init__(self, max_bytes: int) -> None:
-        self.max_bytes, self.bytes = max_bytes, 0
-        self._rows: OrderedDict[Hashable, tuple[np.ndarray, ...]] = OrderedDict()
-
-    def __contains__(self, key: Hashable) -> bool:
-        return key in self._rows
-
-    def get(self, key: Hashable, make: Callable[[], tuple[np.ndarray, ...]]) -> tuple[np.ndarray, ...]:
-        rows = self._rows.get(key)
-        if rows is not None:
-            self._rows.move_to_end(key)
-            return rows
-        rows = make()
-        for row in rows:
-            if isinstance(row, np.ndarray):
-                row.flags.writeable = False
-        size = sum(_nbytes(row) for row in rows)
-        while self._rows and self.bytes + size > self.max_bytes:
-            _, old = self._rows.popitem(last=False)
-            self.bytes -= sum(_nbytes(row) for row in old)
-        if size <= self.max_bytes:
-            self._rows[key] = rows
-            self.bytes += size
-        return rows
-
-
-def _nbytes(value: object) -> int:
-    """Bytes of an array or of a sparse matrix's three arrays."""
-    if isinstance(value, np.ndarray):
-        return value.nbytes
-    return sum(getattr(value, part).nbytes for part in ("data", "indices", "indptr"))
-
-
-def finish_search(search: Generator[None, None, tuple[np.ndarray, np.ndarray]],
-                  ) -> tuple[np.ndarray, np.ndarray]:
-    """Run a paused :meth:`NodeGraph.hop_ball_search` to its end: its result."""
-    while True:
-        try:
-            next(search)
-        except StopIteration as done:
-            found: tuple[np.ndarray, np.ndarray] = done.value
-            return found
-
-
-def _as_hops(found: np.ndarray) -> np.ndarray:
-    """A float hop array from a search as int32, :data:`UNREACHABLE_HOPS` where infinite."""
-    out = np.full(found.shape, UNREACHABLE_HOPS, dtype=np.int32)
-    finite = np.isfinite(found)
-    out[finite] = found[finite]
-    return out
-
-
 @dataclass(eq=False)
 class NodeGraph:
     """Nodes, adjacency and distance queries of one level in one abstraction.
@@ -196,14 +142,10 @@ class NodeGraph:
         self.adjacency = csr_matrix((lengths, (rows, cols)), shape=(n, n))
         if self.dense is None:
             self.dense = n <= DENSE_MAX_NODES
-        self._rows = RowCache(ROW_CACHE_BYTES)
         self._labels: np.ndarray | None = None
-        if self.dense:
-            hop_matrix = shortest_path(self.adjacency, method="D", unweighted=True)
-            self._hops = _as_hops(hop_matrix)
-            self._dist, self._pred = shortest_path(
-                self.adjacency, method="D", directed=False, return_predecessors=True
-            )
+        #: the storage strategy every distance query goes to (chosen here, once)
+        self.distances: Distances = distances_for(self.adjacency, lambda: self._neighbour_table,
+                                                  bool(self.dense))
 
     # ------------------------------------------------------------------ construction
     @classmethod
@@ -311,67 +253,19 @@ class NodeGraph:
         search on a large graph only visits the ball of radius ``max_hops``.
         """
         if not np.isscalar(src) and np.ndim(src) > 0:
-            nodes = np.asarray(src, dtype=np.intp)
-            if self.dense and max_hops is None:
-                return self._hops[nodes]
-            return np.stack([self.hops_from(int(s), max_hops) for s in nodes]) if len(nodes) else (
-                np.zeros((0, self.n), dtype=np.int32)
-            )
-        s = int(np.asarray(src))
-        if self.dense:
-            row = self._hops[s]
-            if max_hops is None:
-                return row
-            out = np.where(row <= max_hops, row, UNREACHABLE_HOPS).astype(np.int32)
-            out.flags.writeable = False
-            return out
-        def make() -> tuple[np.ndarray]:
-            inside, hops = self.hop_ball(s, max_hops)
-            row = np.full(self.n, UNREACHABLE_HOPS, dtype=np.int32)
-            row[inside] = hops
-            return (row,)
-
-        (row,) = self._rows.get(("hops", s, max_hops), make)
-        return row
+            return self.distances.hops_rows(np.asarray(src, dtype=np.intp), max_hops)
+        return self.distances.hops_row(int(np.asarray(src)), max_hops)
 
     def hop_ball(self, src: int, max_hops: int | None = None) -> tuple[np.ndarray, np.ndarray]:
         """The nodes within ``max_hops`` of ``src`` (sorted) and their hop distances (int32):
         the finite part of :meth:`hops_from`, without keeping an (n,) row on a large graph."""
-        s = int(src)
-        if self.dense:
-            row = self._hops[s]
-            inside = np.flatnonzero(row < UNREACHABLE_HOPS if max_hops is None else row <= max_hops)
-            return inside, row[inside]
-        return finish_search(self.hop_ball_search(s, max_hops))
+        return self.distances.hop_ball(int(src), max_hops)
 
-    def hop_ball_search(self, src: int, max_hops: int | None = None,
-                        ) -> Generator[None, None, tuple[np.ndarray, np.ndarray]]:
-        """:meth:`hop_ball` as a breadth-first search that pauses (yields) after each ring,
-        so a caller with a time budget can spread one ball over several frames; it returns
-        (``StopIteration.value``) the same sorted nodes and hops. A ring is one gather from
-        the padded neighbour table and a few vector operations, without the (n,) setup of a
-        scipy search; hop counts are exact integers either way."""
-        table, visited = self._neighbour_table, np.zeros(self.n + 1, dtype=bool)
-        visited[self.n] = True  # the padding's node: never entered
-        slot = np.empty(self.n + 1, dtype=np.intp)  # dedup without sorting: last write wins
-        hop = np.empty(self.n + 1, dtype=np.int32)
-        ring = np.array([int(src)], dtype=np.intp)
-        visited[ring] = True
-        hop[ring] = 0
-        rings = 1
-        depth = self.n if max_hops is None else int(max_hops)
-        while len(ring) and rings <= depth:
-            reached = table[ring].ravel()
-            reached = reached[~visited[reached]]
-            order = np.arange(len(reached))
-            slot[reached] = order
-            ring = reached[slot[reached] == order]
-            visited[ring] = True
-            hop[ring] = rings
-            rings += 1
-            yield
-        nodes = np.flatnonzero(visited[: self.n])
-        return nodes, hop[nodes]
+    def hop_search(self, src: int, max_hops: int | None = None) -> SlicedSearch:
+        """:meth:`hop_ball` as a breadth-first search the caller runs a ring at a time
+        (:class:`~navmesh.distances.SlicedSearch`), so a caller with a time budget can spread
+        one ball over several frames; it finds the same sorted nodes and hops."""
+        return self.distances.hop_search(int(src), max_hops)
 
     @cached_property
     def _neighbour_table(self) -> np.ndarray:
@@ -385,34 +279,10 @@ class NodeGraph:
 
     def hops_between(self, a: int | np.ndarray | Sequence[int], b: int | np.ndarray | Sequence[int]) -> np.ndarray | int:
         """Hop distance of each pair (a[i], b[i]) (broadcast like numpy indexing)."""
-        found = self._pairwise(a, b, lambda: self._hops, self.hops_from, np.int32)
+        found = self.distances.hops_between(a, b)
         return int(found) if found.ndim == 0 else found
 
-    def _pairwise(self, a: Any, b: Any, dense: Callable[[], np.ndarray],
-                  row: Callable[[int], np.ndarray], dtype: type) -> np.ndarray:
-        """Each pair's value from the dense matrix, or from one per-source row per source."""
-        if self.dense:
-            return np.asarray(dense()[a, b])
-        a_arr, b_arr = np.broadcast_arrays(np.asarray(a, dtype=np.intp), np.asarray(b, dtype=np.intp))
-        out: np.ndarray = np.empty(a_arr.shape, dtype=dtype)
-        for s in np.unique(a_arr):
-            mask = a_arr == s
-            out[mask] = row(int(s))[b_arr[mask]]
-        return out
-
     # ------------------------------------------------------------------ metric distances
-    def _dist_pred(self, s: int) -> tuple[np.ndarray, np.ndarray]:
-        if self.dense:
-            return self._dist[s], self._pred[s]
-        dist, pred = self._rows.get(
-            ("dist", s),
-            # symmetric adjacency: the directed search relaxes the same edges in the same
-            # order as the undirected one (same rows, same predecessors), without scipy
-            # transposing the matrix on every call
-            lambda: tuple(dijkstra(self.adjacency, indices=s, return_predecessors=True)),
-        )
-        return dist, pred
-
     def dist_from(self, src: int | Sequence[int] | np.ndarray, limit: float | None = None) -> np.ndarray:
         """Shortest-path distances from ``src`` (an int: (n,); several: (k, n)), read-only.
 
@@ -421,26 +291,12 @@ class NodeGraph:
         ``src[i]``: d(a, b) is summed from a, so it may differ from d(b, a) in the last bit.
         """
         if not np.isscalar(src) and np.ndim(src) > 0:
-            nodes = np.asarray(src, dtype=np.intp)
-            if self.dense and limit is None:
-                return self._dist[nodes]
-            if not len(nodes):
-                return np.zeros((0, self.n))
-            return np.stack([self.dist_from(int(s), limit) for s in nodes])
-        s = int(np.asarray(src))
-        if limit is None:
-            return self._dist_pred(s)[0]
-        if self.dense:
-            row = self._dist[s]
-            out = np.where(row <= limit, row, np.inf)
-        else:
-            out = dijkstra(self.adjacency, indices=s, limit=float(limit))  # symmetric: no transpose
-        out.flags.writeable = False
-        return out
+            return self.distances.dist_rows(np.asarray(src, dtype=np.intp), limit)
+        return self.distances.dist_row(int(np.asarray(src)), limit)
 
     def dist_between(self, a: int | np.ndarray | Sequence[int], b: int | np.ndarray | Sequence[int]) -> np.ndarray | float:
         """d(a[i], b[i]) of each pair (broadcast like numpy indexing), searched from a."""
-        found = self._pairwise(a, b, lambda: self._dist, self.dist_from, np.float64)
+        found = self.distances.dist_between(a, b)
         return float(found) if found.ndim == 0 else found
 
     def nearest_dist(
@@ -457,40 +313,21 @@ class NodeGraph:
         values inside it unchanged). ``inf`` with no source. With ``around``, only the nodes
         within metric distance ``reach`` of node ``around`` are promised (others may be
         ``inf``). A large graph answers every unlimited call with one search over the whole
-        graph per set of sources, cached: guards change nodes less often than the callers
-        ask (each physics step, each player move), so the row is shared by the distance
-        metric and the players until a guard moves (measured faster than a search bounded
-        at the nearest source, which needs a second search to find that bound).
+        graph per set of sources, cached (measured faster than a search bounded at the
+        nearest source, which needs a second search to find that bound).
         """
         del around, reach  # a full row keeps every promise
         nodes = np.asarray(srcs, dtype=np.intp).ravel()
         if not len(nodes):
             return np.full(self.n, np.inf)
-        if self.dense:
-            found = self._dist[nodes].min(axis=0)
-            if limit is not None:
-                found = np.where(found <= limit, found, np.inf)
-            return found
-        if len(nodes) == 1 and limit is None:
-            return self.dist_from(int(nodes[0]))
-        nearest_key = ("nearest", tuple(sorted(set(nodes.tolist()))), limit)
-        (row,) = self._rows.get(nearest_key, lambda: (self._multi_source(nodes, limit),))
-        return row
-
-    def _multi_source(self, nodes: np.ndarray, limit: float | None) -> np.ndarray:
-        # The adjacency is symmetric, so the directed search gives the undirected distances
-        # without scipy transposing the matrix on every call.
-        return dijkstra(self.adjacency, indices=nodes, min_only=True,
-                        limit=np.inf if limit is None else float(limit))
+        return self.distances.nearest(nodes, limit)
 
     def nearest_dist_to(self, srcs: Sequence[int] | np.ndarray, target: int) -> float:
         """``min_s d(s, target)``: :meth:`nearest_dist` at one node."""
         nodes = np.asarray(srcs, dtype=np.intp).ravel()
         if not len(nodes):
             return np.inf
-        if self.dense:
-            return float(self._dist[nodes, target].min())
-        return float(self.nearest_dist(nodes)[target])
+        return self.distances.nearest_to(nodes, int(target))
 
     def components(self) -> np.ndarray:
         """(n,) label of every node's connected piece."""
@@ -509,7 +346,7 @@ class NodeGraph:
         if a == b:
             return [a]
         path = [b]
-        pred = self._dist_pred(int(a))[1]
+        pred = self.distances.dist_pred(int(a))[1]
         while path[-1] != a:
             prev = int(pred[path[-1]])
             if prev < 0:

@@ -38,7 +38,9 @@ from pytiled_parser import layer as tl
 from pytiled_parser import tiled_object as to
 from shapely.geometry import Polygon, box
 
-from navmesh.level import Level, LevelError, parse_level, zone_kinds
+from navmesh.errors import LevelError
+from navmesh.level_fields import zone_kinds
+from navmesh.level_format import Level, parse_level
 
 __all__ = ["ELLIPSE_SIDES", "load_tiled", "tiled_level_data"]
 

@@ -9,7 +9,7 @@ from pathlib import Path
 
 import pytest
 
-import navmesh.level as level_module
+import navmesh.level_fields as level_module
 
 ROOT = Path(__file__).resolve().parents[1]
 DOC = ROOT / "docs" / "api.md"

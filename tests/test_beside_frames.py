@@ -20,6 +20,7 @@ from scipy.sparse.csgraph import dijkstra
 
 from ai.fields import CompositeField, FieldMatrices
 from ai.params import PFParams
+from ai.prefetch import Prefetch
 from game.distance_worker import DistanceWorker
 from game.front.layers import StaticLayers
 from game.front.render import init_pygame
@@ -52,23 +53,32 @@ def test_ring_by_ring_balls_equal_the_scipy_search() -> None:
 def test_balls_searched_ahead_equal_the_ones_searched_when_needed() -> None:
     graph = _sparse_grid(1)
     ahead, now = FieldMatrices(graph, PFParams()), FieldMatrices(graph, PFParams())
+    prefetch = Prefetch(ahead.spreads)
     nodes = [3, 40, 41, 300, 3]
     for node in nodes:
-        ahead.anticipate(node)
-    ahead.warm(0.0)  # one ring: the first search is left half done
-    assert ahead._warming is not None
-    half_done = ahead._warming[1]
+        prefetch.expect(node)
+    prefetch.run(0.0)  # one ring: the first search is left half done
+    assert prefetch.searching is not None
+    half_done = prefetch.searching[1]
     # a decision that needs the half-done ball finishes that search, with the same result
     assert np.array_equal(ahead.conf_spread(half_done), now.conf_spread(half_done))
-    ahead.warm(10.0)
+    prefetch.run(10.0)
     for node in nodes:
-        assert ("ball", "C", node) in ahead._rows
+        assert not ahead.spreads.wanted("C", node)
         assert np.array_equal(ahead.conf_spread(node), now.conf_spread(node))
     assert np.array_equal(ahead.deposit(nodes), now.deposit(nodes))
-    ahead.anticipate(7, "I")  # a sighting's information ball, searched ahead as well
-    ahead.warm(10.0)
-    assert ("ball", "I", 7) in ahead._rows
-    assert np.array_equal(ahead.info_spread(7), now.info_spread(7))
+    prefetch.expect(7, "I")  # a sighting's information ball, searched ahead as well
+    assert prefetch.ahead
+    prefetch.run(10.0)
+    assert not ahead.spreads.wanted("I", 7) and not prefetch.ahead
+
+
+def test_nothing_is_searched_ahead_on_a_graph_whose_spreads_are_rows() -> None:
+    graph = NodeGraph.from_grid(np.ones((6, 6), dtype=bool), 1.0)
+    prefetch = Prefetch(FieldMatrices(graph, PFParams()).spreads)
+    prefetch.expect(3)
+    prefetch.expect(4, "I")
+    assert not prefetch.ahead and prefetch.searching is None
 
 
 def test_a_field_snapshot_computes_the_fields_of_its_moment() -> None:

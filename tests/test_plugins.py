@@ -20,7 +20,7 @@ import numpy as np
 import pygame
 import pytest
 
-import navmesh.level as level_module
+import navmesh.level_fields as level_module
 from ai.errors import StimulusError
 from ai.stimuli import Measure, Stimulus, load_stimulus
 from game.front.play import PlayGame, PlaySettings

@@ -23,7 +23,7 @@ import shapely
 from shapely import affinity
 from shapely.geometry import Point, Polygon, box
 
-import navmesh.level as level_module
+import navmesh.level_fields as level_module
 from navmesh.level import LEVELS_DIR, LevelError, load_level, parse_level, register_zone_kind
 
 ROOT = Path(__file__).resolve().parents[1]

@@ -43,6 +43,7 @@ from navmesh.level import bundled_level_names
 from game.front.screens import Panel
 from game.front.sound import SoundBoard
 from game.front.best import BestResults
+from game.large.policy import SizePolicy
 from game.objectives import Objectives
 from game.record import HUMAN, QUESTIONS, Recording
 from game.scene import OVERLAYS, Scene, SceneBuilder, overlay_key
@@ -148,11 +149,11 @@ class PlayGame(FrameLoop):
         self.settings = dataclasses.replace(self.settings, level=level)
         self.world = self._build_world(mode)
         self.level = self.world.level
+        policy = SizePolicy.of(self.world.graph)
         self.builder = SceneBuilder(
             self.level, self.world.graph, view_range=self.world.view_range,
             fov_deg=float(self.config["world.fov_deg"]),
-            # a large level's whole-field overlay is computed beside the frames
-            background_fields=not self.world.graph.dense,
+            background_fields=policy.background_fields,
         )
         if self._screen is None:
             pygame.display.set_caption(f"Stealthfield — {self.level.name}")
@@ -160,8 +161,7 @@ class PlayGame(FrameLoop):
             self._screen = pygame.display.set_mode(size, pygame.RESIZABLE)
         self.screen = self._screen
         self.camera = Camera()
-        # a large level's new field values are composed over a few frames (layers.py)
-        stripes = 1 if self.world.graph.dense else COMPOSE_STRIPES
+        stripes = COMPOSE_STRIPES if policy.striped_compose else 1
         self.renderer = Renderer(self.builder.static, self.screen.get_size(), self.camera,
                                  compose_stripes=stripes)
         self.scene: Scene | None = None
@@ -177,7 +177,7 @@ class PlayGame(FrameLoop):
             seed=self.settings.seed, stimuli=self.settings.stimuli,
         )
         world = make_world(spec, self.config, interactive=True)
-        if not world.graph.dense:  # a large level: the distance metric's searches beside the frames
+        if SizePolicy.of(world.graph).distance_worker:
             if self._distances is None or self._distances.graph is not world.graph:
                 self._close_distances()
                 self._distances = DistanceWorker(world.graph)

@@ -1,0 +1,237 @@
+"""The house rules of issue 22, read from the code with ``ast``.
+
+Every import at any depth counts (lazy imports inside functions included); only imports
+under ``if TYPE_CHECKING:`` are left out, since they never run. On that import graph:
+no layering violation (SPEC §1, no carve-out), no import cycle between modules; and on the
+source: no module above 500 lines, ``World`` at most 300 lines, at most two places outside
+``navmesh/`` that read a graph's ``.dense`` (the storage strategy is chosen in navmesh), one
+place that constructs ``World(...)``, at most 15 modules directly in ``headless/``.
+"""
+
+from __future__ import annotations
+
+import ast
+from functools import cache
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+PACKAGES = ("navmesh", "ai", "game", "headless")
+# which of our packages each may import (SPEC §1); game.front is the only pygame importer
+ALLOWED = {
+    "navmesh": {"navmesh"},
+    "ai": {"ai", "navmesh"},
+    "game": {"game", "ai", "navmesh"},
+    "game.front": {"game.front", "game", "ai", "navmesh"},
+    "headless": {"headless", "game", "game.front", "ai", "navmesh"},
+}
+
+
+def _files() -> list[Path]:
+    return sorted(p for package in PACKAGES for p in (ROOT / package).rglob("*.py"))
+
+
+def _module_name(path: Path) -> str:
+    parts = list(path.relative_to(ROOT).with_suffix("").parts)
+    if parts[-1] == "__init__":
+        parts.pop()
+    return ".".join(parts)
+
+
+def _package_of(path: Path) -> str:
+    name = _module_name(path)
+    return name if path.name == "__init__.py" else name.rpartition(".")[0]
+
+
+def _is_type_checking(test: ast.expr) -> bool:
+    return (isinstance(test, ast.Name) and test.id == "TYPE_CHECKING") or (
+        isinstance(test, ast.Attribute) and test.attr == "TYPE_CHECKING")
+
+
+def _walk_running(tree: ast.AST):  # type: ignore[no-untyped-def]
+    """Every node of ``tree`` except the bodies of ``if TYPE_CHECKING:`` blocks."""
+    stack = [tree]
+    while stack:
+        node = stack.pop()
+        yield node
+        if isinstance(node, ast.If) and _is_type_checking(node.test):
+            stack.extend(node.orelse)
+            continue
+        stack.extend(ast.iter_child_nodes(node))
+
+
+@cache
+def _modules() -> frozenset[str]:
+    return frozenset(_module_name(p) for p in _files())
+
+
+def imports(path: Path, source: str | None = None, package: str | None = None) -> list[str]:
+    """The modules ``path`` imports at any depth (``from P import m`` names ``P.m`` when that
+    is a module of ours), ``TYPE_CHECKING`` blocks excepted."""
+    tree = ast.parse(source if source is not None else path.read_text(encoding="utf-8"))
+    package = _package_of(path) if package is None else package
+    found: list[str] = []
+    for node in _walk_running(tree):
+        if isinstance(node, ast.Import):
+            found += [alias.name for alias in node.names]
+        elif isinstance(node, ast.ImportFrom):
+            if node.level:
+                base = package.split(".")[: len(package.split(".")) - node.level + 1]
+                parent = ".".join(base + ([node.module] if node.module else []))
+            else:
+                parent = node.module or ""
+            for alias in node.names:
+                sub = f"{parent}.{alias.name}"
+                found.append(sub if sub in _modules() else parent)
+    return found
+
+
+def _layer(module: str) -> str:
+    if module == "game.front" or module.startswith("game.front."):
+        return "game.front"
+    return module.split(".")[0]
+
+
+@cache
+def _graph() -> dict[str, set[str]]:
+    ours = _modules()
+    graph: dict[str, set[str]] = {}
+    for path in _files():
+        graph[_module_name(path)] = {m for m in imports(path) if m in ours}
+    return graph
+
+
+def layering_violations() -> list[str]:
+    bad = []
+    for path in _files():
+        me = _module_name(path)
+        layer = _layer(me)
+        for module in imports(path):
+            root = module.split(".")[0]
+            if root == "pygame" and layer != "game.front":
+                bad.append(f"{me} imports {module}")
+            if root in PACKAGES and _layer(module) not in ALLOWED[layer]:
+                bad.append(f"{me} imports {module}")
+    return bad
+
+
+def import_cycles(graph: dict[str, set[str]]) -> list[list[str]]:
+    """The strongly connected components of more than one module (Tarjan), sorted."""
+    index: dict[str, int] = {}
+    low: dict[str, int] = {}
+    on_stack: set[str] = set()
+    stack: list[str] = []
+    found: list[list[str]] = []
+
+    def visit(v: str) -> None:
+        index[v] = low[v] = len(index)
+        stack.append(v)
+        on_stack.add(v)
+        for w in sorted(graph.get(v, ())):
+            if w not in index:
+                visit(w)
+                low[v] = min(low[v], low[w])
+            elif w in on_stack:
+                low[v] = min(low[v], index[w])
+        if low[v] == index[v]:
+            component = []
+            while True:
+                w = stack.pop()
+                on_stack.discard(w)
+                component.append(w)
+                if w == v:
+                    break
+            if len(component) > 1 or v in graph.get(v, ()):
+                found.append(sorted(component))
+
+    for v in sorted(graph):
+        if v not in index:
+            visit(v)
+    return sorted(found)
+
+
+def test_no_layering_violation_at_any_depth() -> None:
+    assert layering_violations() == []
+
+
+def test_no_import_cycle_between_modules() -> None:
+    assert import_cycles(_graph()) == []
+
+
+def test_no_module_above_500_lines() -> None:
+    long = {str(p.relative_to(ROOT)): n for p in _files()
+            if (n := len(p.read_text(encoding="utf-8").splitlines())) > 500}
+    assert long == {}
+
+
+def test_world_is_at_most_300_lines() -> None:
+    tree = ast.parse((ROOT / "game" / "world.py").read_text(encoding="utf-8"))
+    (world,) = [n for n in tree.body if isinstance(n, ast.ClassDef) and n.name == "World"]
+    assert world.end_lineno is not None
+    assert world.end_lineno - world.lineno + 1 <= 300
+
+
+def _places(predicate) -> list[str]:  # type: ignore[no-untyped-def]
+    found = []
+    for path in _files():
+        tree = ast.parse(path.read_text(encoding="utf-8"))
+        found += [f"{path.relative_to(ROOT)}:{node.lineno}"
+                  for node in _walk_running(tree) if predicate(path, node)]
+    return sorted(found)
+
+
+def _reads_dense(path: Path, node: ast.AST) -> bool:
+    return (path.relative_to(ROOT).parts[0] != "navmesh" and isinstance(node, ast.Attribute)
+            and node.attr == "dense")
+
+
+def _constructs_world(path: Path, node: ast.AST) -> bool:
+    if not isinstance(node, ast.Call):
+        return False
+    f = node.func
+    return (isinstance(f, ast.Name) and f.id == "World") or (
+        isinstance(f, ast.Attribute) and f.attr == "World")
+
+
+def test_graph_size_is_read_in_at_most_two_places_outside_navmesh() -> None:
+    assert len(_places(_reads_dense)) <= 2, _places(_reads_dense)
+
+
+def test_one_place_constructs_a_world() -> None:
+    assert len(_places(_constructs_world)) == 1, _places(_constructs_world)
+
+
+def test_at_most_15_modules_directly_in_headless() -> None:
+    direct = sorted(p.name for p in (ROOT / "headless").glob("*.py") if p.name != "__init__.py")
+    assert len(direct) <= 15, direct
+
+
+def test_every_sub_package_opens_with_a_one_line_docstring() -> None:
+    bad = []
+    for init in sorted(p for package in PACKAGES for p in (ROOT / package).rglob("__init__.py")):
+        doc = ast.get_docstring(ast.parse(init.read_text(encoding="utf-8")))
+        if not doc or not doc.splitlines()[0].strip():
+            bad.append(str(init.relative_to(ROOT)))
+    assert bad == []
+
+
+# the checkers themselves
+
+@pytest.mark.parametrize("source, expected", [
+    ("from .errors import X", ["game.errors"]),
+    ("def f():\n    from game.front import render", ["game.front.render"]),
+    ("import pygame", ["pygame"]),
+    ("from typing import TYPE_CHECKING\nif TYPE_CHECKING:\n    import headless\n", ["typing"]),
+    ("class A:\n    def m(self):\n        if x:\n            import headless.cli\n",
+     ["headless.cli"]),
+])
+def test_the_checker_sees_relative_lazy_and_nested_imports(source: str,
+                                                            expected: list[str]) -> None:
+    assert imports(ROOT / "game" / "probe.py", source) == expected
+
+
+def test_the_cycle_finder_finds_a_lazy_cycle() -> None:
+    graph = {"a": {"b"}, "b": {"c"}, "c": {"a"}, "d": {"a"}}
+    assert import_cycles(graph) == [["a", "b", "c"]]
+    assert import_cycles({"a": {"b"}, "b": set()}) == []
