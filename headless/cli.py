@@ -26,6 +26,7 @@ from ai import GUARD_MODES, PLAYER_POLICIES
 from navmesh.errors import StealthError
 from navmesh.graph import ABSTRACTIONS
 
+from . import warning_lines
 from .errors import UserError
 
 EXIT_USER_ERROR = 2
@@ -550,6 +551,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     words = list(sys.argv[1:] if argv is None else argv)
     debug = "--debug" in words[:words.index("--")] if "--" in words else "--debug" in words
     _tolerant_streams()
+    warning_lines.install()
     try:
         args = build_parser().parse_args(words)
         return int(args.func(args))

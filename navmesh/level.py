@@ -38,6 +38,7 @@ from shapely.geometry.polygon import orient
 from navmesh.errors import LevelError
 from navmesh.files import FileRefused, read_regular
 from navmesh.grid_geometry import cells_polygon
+from navmesh.tiled_format import is_tiled_json, is_tiled_suffix, is_tiled_xml
 
 __all__ = [
     "FORMAT",
@@ -244,8 +245,8 @@ def resolve_level_path(path_or_name: str | Path) -> Path:
 def load_level(path_or_name: str | Path) -> Level:
     """Load and validate a level from a JSON file, a Tiled map or a bundled level name.
 
-    A ``.tmj`` file, or a JSON file whose ``"type"`` is ``"map"``, is a Tiled map, read by
-    :mod:`navmesh.tiled` into the same structure. Errors name the file as the caller gave
+    A Tiled map (``.tmj``, ``.tmx``, or a file whose content is one, see
+    :mod:`navmesh.tiled_format`) is read by :mod:`navmesh.tiled` into the same structure. Errors name the file as the caller gave
     it (a bundled level by its file name).
     """
     content = _read_level_file(path_or_name)
@@ -264,12 +265,15 @@ def cached_level(path_or_name: str | Path) -> Level:
 
 
 def parse_level(
-    data: Any, source: str = "<memory>", *, path: Path | None = None, digest: str | None = None
+    data: Any, source: str = "<memory>", *, path: Path | None = None, digest: str | None = None,
+    require_guards: bool = True,
 ) -> Level:
     """Validate an in-memory level (the decoded JSON object) and build its :class:`Level`.
 
     ``source`` names the level in error messages; ``path`` and ``digest`` (the content
-    identity of the file it came from) are stored on the result.
+    identity of the file it came from) are stored on the result. ``require_guards=False``
+    accepts an empty ``guards`` list (a Tiled map without guard objects: its guards spawn
+    at random nodes, :func:`game.spawns.guard_spawn_nodes`).
     """
     src = source
     if not isinstance(data, dict):
@@ -310,7 +314,7 @@ def parse_level(
 
     zones = _parse_zones(data.get("zones", {}), walkable, src)
     level_spots = dict(walkable=walkable, occupancy=occupancy, outline=outline, cell_size=cell_size)
-    guards = _parse_spots(data["guards"], src, "guards", required=True, **level_spots)
+    guards = _parse_spots(data["guards"], src, "guards", required=require_guards, **level_spots)
     decoys = _parse_spots(data.get("decoys", []), src, "decoys", required=False, **level_spots)
     collectibles = _parse_spots(
         data.get("collectibles", []), src, "collectibles", required=False, **level_spots
@@ -363,8 +367,11 @@ def _read_level_file(path_or_name: str | Path) -> _LevelFile:
 
 
 def _parse_content(content: _LevelFile) -> Level:
-    data = _decode_json(content.raw, content.source)
-    if content.path.suffix.lower() == ".tmj" or (isinstance(data, dict) and data.get("type") == "map"):
+    tiled = is_tiled_suffix(content.path) or is_tiled_xml(content.raw)
+    if not tiled:
+        data = _decode_json(content.raw, content.source)
+        tiled = is_tiled_json(data)
+    if tiled:
         from navmesh.tiled import load_tiled  # lazy: imports this module and pytiled-parser
 
         return load_tiled(content.path, content.source, content.digest)
