@@ -504,7 +504,9 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--screenshot", default=None, metavar="FILE.png",
                    help="save the last frame as PNG (default: none)")
     p.add_argument("--overlay", default="none",
-                   help=f"initial field overlay: {', '.join(OVERLAYS)}")
+                   help="initial field overlay, by key or name: " + ", ".join(
+                       key if o is None else f"{key} ({o.aliases[0]})" if o.aliases else key
+                       for key, o in OVERLAYS.items()))
     p.add_argument("--seed", type=_seed, default=0, help="seed of the guards' decisions")
     add_set(p)
     add_config(p)

@@ -174,3 +174,10 @@ def test_an_old_tiled_json_without_type_goes_to_the_tiled_reader(tmp_path):
     level = load_level(path)
     assert level.name == "old" and level.guards == ((0.5, 0.5),)
     assert level.occupancy.tolist() == [[True] * 3, [True, False, True], [True] * 3]
+
+
+def test_the_documented_unknown_key_message_is_the_code_s():
+    """docs/levels.md quotes the unknown-key error with the allowed keys of today's code."""
+    with pytest.raises(LevelError) as refused:
+        parse_level({**MAZE, "walls": []}, "w.json")
+    assert f"`{refused.value}`" in (ROOT / "docs" / "levels.md").read_text()
