@@ -30,7 +30,7 @@ __all__ = ["install"]
 
 def install(stream: TextIO | None = None) -> None:
     """Show LevelWarnings as one line on ``stream`` (default: the current ``sys.stderr``)."""
-    shown = warnings.showwarning
+    shown = getattr(warnings.showwarning, "wrapped", warnings.showwarning)  # installed once
     printed: set[str] = set()
 
     def show(message: Any, category: type[Warning], filename: str, lineno: int,
@@ -43,5 +43,6 @@ def install(stream: TextIO | None = None) -> None:
         else:
             shown(message, category, filename, lineno, file, line)
 
+    show.wrapped = shown  # type: ignore[attr-defined]
     warnings.simplefilter("always", LevelWarning)
     warnings.showwarning = show
