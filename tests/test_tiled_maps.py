@@ -181,3 +181,31 @@ def test_the_documented_unknown_key_message_is_the_code_s():
     with pytest.raises(LevelError) as refused:
         parse_level({**MAZE, "walls": []}, "w.json")
     assert f"`{refused.value}`" in (ROOT / "docs" / "levels.md").read_text()
+
+
+def test_a_staggered_map_is_refused_in_one_line(tmp_path):
+    path = tmp_path / "s.tmx"
+    path.write_text(_maze_tmx("csv").replace('orientation="orthogonal"',
+                                             'orientation="staggered" staggeraxis="y"'))
+    with pytest.raises(LevelError, match="map: orientation 'staggered' is not supported"):
+        load_level(path)
+
+
+@pytest.mark.parametrize("name", sorted(LOADS) + sorted(REFUSED))
+def test_a_broken_copy_of_a_published_map_is_a_one_line_error(tmp_path, name):
+    """Cut short, or with its first line blank: a LevelError (or a level), never a traceback."""
+    text = (HELD / name).read_bytes()
+    folder = tmp_path / Path(name).parent
+    folder.mkdir(parents=True)
+    for source in (HELD / name).parent.iterdir():  # the tilesets and templates beside it
+        if source.is_file():
+            (folder / source.name).write_bytes(source.read_bytes())
+    path = tmp_path / name
+    for broken in (text[:len(text) // 3], text[:2 * len(text) // 3], b"\n" + text):
+        path.write_bytes(broken)
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            try:
+                load_level(path)
+            except LevelError as error:
+                assert "\n" not in str(error)
