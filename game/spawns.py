@@ -17,10 +17,11 @@ from .senses import Senses
 def guard_spawn_nodes(graph: NodeGraph, level: Level, rng: np.random.Generator, count: int,
                       spawns: str) -> list[int]:
     """``spawns = "random"``: ``count`` distinct nodes drawn with ``rng`` (at most n − 1);
-    ``"level"``: the nodes of the level's guard spawn points."""
-    if spawns == "level":
+    ``"level"``: the nodes of the level's guard spawn points — or, for a level without any
+    (a Tiled map without guard objects, which warns when loaded), random ones as above."""
+    if spawns == "level" and level.guards:
         return [graph.node_at(x, y) for x, y in level.guards]
-    if spawns != "random":
+    if spawns not in SPAWN_RULES:
         raise ValueError(f"world.spawns: expected one of {SPAWN_RULES}, got {spawns!r}")
     count = min(count, graph.n - 1)
     return [int(v) for v in rng.choice(graph.n, size=count, replace=False)]

@@ -26,6 +26,7 @@ from ai import GUARD_MODES, PLAYER_POLICIES
 from navmesh.errors import StealthError
 from navmesh.graph import ABSTRACTIONS
 
+from . import warning_lines
 from .errors import UserError
 
 EXIT_USER_ERROR = 2
@@ -507,7 +508,9 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--screenshot", default=None, metavar="FILE.png",
                    help="save the last frame as PNG (default: none)")
     p.add_argument("--overlay", default="none",
-                   help=f"initial field overlay: {', '.join(OVERLAYS)}")
+                   help="initial field overlay, by key or name: " + ", ".join(
+                       key if o is None else f"{key} ({o.aliases[0]})" if o.aliases else key
+                       for key, o in OVERLAYS.items()))
     p.add_argument("--seed", type=_seed, default=0, help="seed of the guards' decisions")
     add_set(p)
     add_config(p)
@@ -554,6 +557,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     words = list(sys.argv[1:] if argv is None else argv)
     debug = "--debug" in words[:words.index("--")] if "--" in words else "--debug" in words
     _tolerant_streams()
+    warning_lines.install()
     try:
         args = build_parser().parse_args(words)
         return int(args.func(args))

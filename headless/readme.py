@@ -45,7 +45,8 @@ def readme(directory: Path, meta: Mapping[str, str], done: int, skipped_heat: in
         "",
         "| file | contents |",
         "|---|---|",
-        f"| `{STORE_NAME}` | the store: one row per trial (SQLite; see docs/experiments.md) |",
+        f"| `{STORE_NAME}` | the store: one row per trial (SQLite; its tables: "
+        "`python -m pydoc headless.store`, shipped with the package) |",
         "| `trials.csv` | one row per finished trial: identity, seed, config hash, every "
         "metric, `wall_time` (s) last |",
         "| `table.md`, `table.csv` | paper Table 3: mean ± std and 95 % bootstrap CI per "

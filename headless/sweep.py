@@ -32,6 +32,7 @@ from game.trial import TrialSpec
 
 from .dirlock import DirectoryLock
 from .errors import SweepError
+from .estimate import MEASURED_DURATION, duration_text, estimate_seconds
 from .executors import (
     InlineExecutor,
     check_workers,
@@ -210,6 +211,8 @@ def run_sweep(
         if result.skipped and progress:
             stream.write(f"resuming: {result.skipped} of {len(specs)} trials already in "
                          f"{store_path}, {len(todo)} to run\n")
+        if progress:
+            _write_estimate(stream, preset, todo, parallelism)
         if executor is None:
             executor = process_pool(workers)
         inline = isinstance(executor, InlineExecutor)
@@ -232,6 +235,18 @@ def run_sweep(
             store.close()
         if lock is not None:
             lock.close()
+
+
+def _write_estimate(stream: IO[str], preset: Preset, todo: list[TrialSpec], workers: int
+                    ) -> None:
+    """One line: the expected wall time of the trials to run (:mod:`headless.estimate`)."""
+    names = dict(zip(preset.levels, preset.level_names))
+    seconds = estimate_seconds(((names.get(s.level, s.level), s.abstraction, s.scenario)
+                                for s in todo), workers,
+                               float(preset.config.get("world.duration", MEASURED_DURATION)))
+    stream.write(f"stealth: estimate: about {duration_text(seconds)} for {len(todo)} trials on "
+                 f"{workers} worker{'s' if workers != 1 else ''} (per-trial times measured "
+                 "on 2 vCPUs; the ETA below then uses the real rate)\n")
 
 
 def _record(rows: Iterable[dict[str, Any]], store: ResultStore, preset: Preset,

@@ -16,7 +16,7 @@ True
 
 from __future__ import annotations
 
-__all__ = ["LevelError", "OutsideError", "StealthError", "UserError"]
+__all__ = ["LevelError", "LevelWarning", "OutsideError", "StealthError", "UserError"]
 
 
 def _one_line(text: str) -> str:
@@ -37,6 +37,26 @@ class LevelError(StealthError, ValueError):
     ``str(error)`` is one line, ``"<file>: <field>: <problem>"``; the three parts are also
     available as ``source``, ``field`` and ``problem``. The exception pickles (it is raised
     inside worker processes too).
+    """
+
+    def __init__(self, source: str, field: str, problem: str) -> None:
+        super().__init__(source, field, problem)
+        self.source = _one_line(source)
+        self.field = _one_line(field)
+        self.problem = _one_line(problem)
+
+    def __str__(self) -> str:
+        return f"{self.source}: {self.field}: {self.problem}"
+
+
+class LevelWarning(UserWarning):
+    """A level loads, but probably not as its author meant (a Tiled map without walls or
+    guards, an object class Stealthfield does not know): issued with :func:`warnings.warn`,
+    one line ``"<file>: <field>: <problem>"``, which the ``stealth`` command prints as
+    ``stealth: warning: ...``.
+
+    >>> str(LevelWarning("m.tmx", "map", "no walls"))
+    'm.tmx: map: no walls'
     """
 
     def __init__(self, source: str, field: str, problem: str) -> None:

@@ -39,6 +39,7 @@ from navmesh.level_fields import (
     zone_kinds,
 )
 from navmesh.level_format import FORMAT, Level, parse_level
+from navmesh.tiled_format import is_tiled_json, is_tiled_suffix, is_tiled_xml
 
 __all__ = [
     "FORMAT",
@@ -152,8 +153,11 @@ def _read_level_file(path_or_name: str | Path) -> _LevelFile:
 
 
 def _parse_content(content: _LevelFile) -> Level:
-    data = _decode_json(content.raw, content.source)
-    if content.path.suffix.lower() == ".tmj" or (isinstance(data, dict) and data.get("type") == "map"):
+    tiled = is_tiled_suffix(content.path) or is_tiled_xml(content.raw)
+    if not tiled:
+        data = _decode_json(content.raw, content.source)
+        tiled = is_tiled_json(data)
+    if tiled:
         from navmesh.tiled import load_tiled  # lazy: pytiled-parser only when a map is read
 
         return load_tiled(content.path, content.source, content.digest)

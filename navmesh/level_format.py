@@ -165,12 +165,15 @@ class Level:
 
 
 def parse_level(
-    data: Any, source: str = "<memory>", *, path: Path | None = None, digest: str | None = None
+    data: Any, source: str = "<memory>", *, path: Path | None = None, digest: str | None = None,
+    require_guards: bool = True,
 ) -> Level:
     """Validate an in-memory level (the decoded JSON object) and build its :class:`Level`.
 
     ``source`` names the level in error messages; ``path`` and ``digest`` (the content
-    identity of the file it came from) are stored on the result.
+    identity of the file it came from) are stored on the result. ``require_guards=False``
+    accepts an empty ``guards`` list (a Tiled map without guard objects: its guards spawn
+    at random nodes, :func:`game.spawns.guard_spawn_nodes`).
     """
     src = source
     if not isinstance(data, dict):
@@ -211,7 +214,7 @@ def parse_level(
 
     zones = _parse_zones(data.get("zones", {}), walkable, src)
     level_spots = dict(walkable=walkable, occupancy=occupancy, outline=outline, cell_size=cell_size)
-    guards = _parse_spots(data["guards"], src, "guards", required=True, **level_spots)
+    guards = _parse_spots(data["guards"], src, "guards", required=require_guards, **level_spots)
     decoys = _parse_spots(data.get("decoys", []), src, "decoys", required=False, **level_spots)
     collectibles = _parse_spots(
         data.get("collectibles", []), src, "collectibles", required=False, **level_spots

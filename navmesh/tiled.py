@@ -1,7 +1,7 @@
 """Tiled maps as levels (SPEC §10 "Tiled maps").
 
-A Tiled JSON map (``.tmj``, or a ``.json`` whose ``"type"`` is ``"map"``) is read with
-pytiled-parser and converted into the level structure of SPEC §8, which
+A Tiled map — JSON (``.tmj``, or a ``.json`` that is one, see :mod:`navmesh.tiled_format`)
+or TMX (XML, ``.tmx``), with JSON or TSX tilesets — is read with pytiled-parser and converted into the level structure of SPEC §8, which
 :func:`navmesh.level.parse_level` then validates: both formats share every check, and a
 validation error is reported against the Tiled layer or object it came from.
 
@@ -18,15 +18,19 @@ Conventions (documented for level designers in ``docs/levels.md``):
   honoured): ``exit`` and every zone kind of :func:`navmesh.level.zone_kinds`.
 
 Object classes are matched on the object's ``class`` (Tiled >= 1.9) or legacy ``type``,
-case-insensitively; objects without a class are decoration and ignored, an unknown class
-is an error (a typo would otherwise silently drop a guard). Layer offsets count (those of
-enclosing groups added up); parallax, visibility and opacity are rendering matters and are
-ignored.
+case-insensitively; objects without a class are decoration and ignored, and so is an
+object of a class Stealthfield does not know, with one :class:`~navmesh.errors.LevelWarning`
+each (a published map has classes of its own game; a typo'd guard is named in that line).
+A map without guard objects also warns: its guards take the world's random spawns. A map
+without walls, obstacles or an outline warns that it is an empty box (an infinite one is
+cut to the bounds of all its tiles). Layer offsets count (those of enclosing groups added
+up); parallax, visibility and opacity are rendering matters and are ignored.
 """
 
 from __future__ import annotations
 
 import math
+import warnings
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, NoReturn
@@ -34,13 +38,15 @@ from typing import Any, NoReturn
 import numpy as np
 import pytiled_parser
 import shapely
+from scipy import ndimage
 from pytiled_parser import layer as tl
 from pytiled_parser import tiled_object as to
 from shapely.geometry import Polygon, box
 
-from navmesh.errors import LevelError
+from navmesh.errors import LevelError, LevelWarning
 from navmesh.level_fields import zone_kinds
 from navmesh.level_format import Level, parse_level
+from navmesh.tiled_read import read_map
 
 __all__ = ["ELLIPSE_SIDES", "load_tiled", "tiled_level_data"]
 
@@ -63,18 +69,30 @@ class _Collected:
     """(layer, tile columns, tile rows, offset x px, offset y px) of each walls layer."""
     shapes: dict[str, list[tuple[str, Any]]] = field(default_factory=dict)
     """class -> [(object description, shapely geometry in pixels)]."""
+    tile_offsets: list[tuple[float, float]] = field(default_factory=list)
+    """The pixel offset of the layer of each entry of ``tile_boxes``."""
+    tile_boxes: list[tuple[float, float, float, float]] = field(default_factory=list)
+    """Tile bounds (x0, y0, x1, y1 in columns and rows) of the non-zero tiles of each tile
+    layer: an infinite map's extent when it has no walls, obstacles or outline."""
 
 
 def load_tiled(path: Path, source: str, digest: str | None = None) -> Level:
     """Read a Tiled map and validate it as a level; errors name the Tiled layer or object.
 
     ``digest`` is the content identity of the file (see :func:`navmesh.level.cached_level`).
+    The map's :class:`~navmesh.errors.LevelWarning` lines are issued only if it loads: a
+    refused map is its one error line.
     """
-    data, origins = tiled_level_data(path, source)
-    try:
-        return parse_level(data, source, path=path, digest=digest)
-    except LevelError as exc:
-        raise LevelError(source, _origin(exc.field, origins), exc.problem) from None
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always", LevelWarning)
+        data, origins = tiled_level_data(path, source)
+        try:
+            level = parse_level(data, source, path=path, digest=digest, require_guards=False)
+        except LevelError as exc:
+            raise LevelError(source, _origin(exc.field, origins), exc.problem) from None
+    for note in caught:
+        warnings.warn_explicit(note.message, note.category, note.filename, note.lineno)
+    return level
 
 
 def tiled_level_data(path: Path, source: str) -> tuple[dict[str, Any], dict[str, str]]:
@@ -95,6 +113,7 @@ def tiled_level_data(path: Path, source: str) -> tuple[dict[str, Any], dict[str,
     found = _Collected()
     _collect(tmap.layers, "", 0.0, 0.0, found, source)
     tile = float(tile_w)
+    _warn_of_missing_parts(found, tmap, source)
 
     # Bounds in tiles: the map's, or for an infinite map those of its content.
     outline_objects = found.shapes.get("outline", [])
@@ -169,7 +188,7 @@ def tiled_level_data(path: Path, source: str) -> tuple[dict[str, Any], dict[str,
 
 
 def _read_map(path: Path, source: str) -> pytiled_parser.TiledMap:
-    """Parse with pytiled-parser; any failure of it becomes a one-line LevelError.
+    """Read with :func:`navmesh.tiled_read.read_map`; any failure becomes a one-line LevelError.
 
     The reader signals malformed input with whatever its code happens to raise (KeyError for
     a missing key, TypeError, ValueError, NotImplementedError for TMX templates, OSError for
@@ -177,7 +196,9 @@ def _read_map(path: Path, source: str) -> pytiled_parser.TiledMap:
     its type: the map is user input and must never end in a traceback.
     """
     try:
-        return pytiled_parser.parse_map(path)
+        return read_map(path, source)
+    except LevelError:
+        raise
     except KeyError as exc:
         _fail(source, "map", f"not a Tiled map Stealthfield can read: missing key {exc}")
     except FileNotFoundError as exc:
@@ -218,17 +239,24 @@ def _collect(
         if isinstance(layer, tl.LayerGroup):
             _collect(layer.layers or [], f"{name}/", lx, ly, found, src)
         elif isinstance(layer, tl.TileLayer):
-            if WALLS in (layer.name.strip().lower(), _class_of(layer)):
-                cols, rows = _nonzero_tiles(layer, name, src)
+            is_walls = WALLS in (layer.name.strip().lower(), _class_of(layer))
+            cols, rows = _nonzero_tiles(layer, name, src, required=is_walls)
+            if is_walls:
                 found.walls.append((name, cols, rows, lx, ly))
+            if cols.size:
+                found.tile_boxes.append((float(cols.min()), float(rows.min()),
+                                         float(cols.max() + 1), float(rows.max() + 1)))
+                found.tile_offsets.append((lx, ly))
         elif isinstance(layer, tl.ObjectLayer):
             for obj in layer.tiled_objects:
                 _collect_object(obj, name, lx, ly, found, src)
         # image layers are pictures only
 
 
-def _nonzero_tiles(layer: tl.TileLayer, name: str, src: str) -> tuple[np.ndarray, np.ndarray]:
-    """Tile columns and rows (layer coordinates) of the layer's non-zero gids."""
+def _nonzero_tiles(layer: tl.TileLayer, name: str, src: str, *, required: bool
+                   ) -> tuple[np.ndarray, np.ndarray]:
+    """Tile columns and rows (layer coordinates) of the layer's non-zero gids; a layer
+    without tile data is an error if ``required`` (a walls layer), else has none."""
     blocks: list[tuple[float, float, list[list[int]]]] = (
         [(0, 0, layer.data)] if layer.data is not None else [])
     blocks += [(c.coordinates.x, c.coordinates.y, c.data) for c in layer.chunks or []]
@@ -239,7 +267,9 @@ def _nonzero_tiles(layer: tl.TileLayer, name: str, src: str) -> tuple[np.ndarray
             cols.append(c + int(x0))
             rows.append(np.full(c.size, r + int(y0)))
     if not cols:
-        _fail(src, f"layer {name!r}", "walls layer has no tile data")
+        if required:
+            _fail(src, f"layer {name!r}", "walls layer has no tile data")
+        return np.zeros(0, np.int64), np.zeros(0, np.int64)
     return np.concatenate(cols), np.concatenate(rows)
 
 
@@ -259,8 +289,9 @@ def _collect_object(
     points = (*_POINT_CLASSES, *_SINGLE_POINT_CLASSES)
     if cls not in areas and cls not in points:
         known = ", ".join((*points, *areas))
-        _fail(src, where, f"unknown class {obj.class_!r} (known classes: {known}; "
-                          "leave the class empty for decoration)")
+        _warn(src, where, f"unknown class {obj.class_!r}, treated as decoration (known "
+                          f"classes: {known})")
+        return
     geometry = _object_geometry(obj, ox, oy, where, src, want_area=cls in areas)
     found.shapes.setdefault(cls, []).append((where, geometry))
 
@@ -313,6 +344,21 @@ def _object_geometry(
 # --------------------------------------------------------------------------- converting
 
 
+def _warn_of_missing_parts(found: _Collected, tmap: pytiled_parser.TiledMap, src: str) -> None:
+    """One warning line for a map without guards, one for a map that is an empty box."""
+    if not found.shapes.get("guard"):
+        _warn(src, "map", "no object of class 'guard': the guards start at random nodes "
+                          "(as with world.spawns = \"random\")")
+    walls = any(c.size for _, c, _, _, _ in found.walls)
+    if not walls and not found.shapes.get("obstacle") and not found.shapes.get("outline"):
+        size = ("infinite" if tmap.infinite
+                else f"{int(tmap.map_size.width)}x{int(tmap.map_size.height)} tiles")
+        _warn(src, "map", f"no walls, obstacles or outline: the level is an empty box "
+                          f"({size}); blocked cells are the tiles of a tile layer named or of "
+                          "class 'walls' and objects of class 'obstacle', an object of class "
+                          "'outline' is the boundary")
+
+
 def _wall_tiles(found: _Collected, tile: float) -> tuple[np.ndarray, np.ndarray]:
     """Tile-aligned wall cells of all walls layers (their offsets are whole tiles)."""
     cols = [c + int(ox // tile) for _, c, _, ox, _ in found.walls]
@@ -332,9 +378,12 @@ def _content_bounds(
             if c.size:
                 boxes.append((c.min() * tile + ox, r.min() * tile + oy,
                               (c.max() + 1) * tile + ox, (r.max() + 1) * tile + oy))
+        if not boxes:  # an empty box: the extent of all its tiles
+            boxes = [(c0 * tile + ox, r0 * tile + oy, c1 * tile + ox, r1 * tile + oy)
+                     for (c0, r0, c1, r1), (ox, oy) in zip(found.tile_boxes, found.tile_offsets)]
         if not boxes:
-            _fail(src, "map", "an infinite map needs a walls tile layer, obstacle objects or "
-                              "an outline object to tell its extent")
+            _fail(src, "map", "an infinite map without tiles, obstacles or an outline object "
+                              "has no extent")
         minx, miny = min(b[0] for b in boxes), min(b[1] for b in boxes)
         maxx, maxy = max(b[2] for b in boxes), max(b[3] for b in boxes)
     return (math.floor(minx / tile), math.floor(miny / tile),
@@ -351,7 +400,24 @@ def _grid(found: _Collected, bounds: tuple[int, int, int, int], tile: float, src
     cols, rows = _wall_tiles(found, tile)
     inside = (cols >= x0) & (cols < x1) & (rows >= y0) & (rows < y1)
     blocked[rows[inside] - y0, cols[inside] - x0] = True
+    _block_pockets(blocked, src)
     return ["".join(row) for row in np.where(blocked, "#", ".").tolist()]
+
+
+def _block_pockets(blocked: np.ndarray, src: str) -> None:
+    """Walkable cells walled off from the largest 4-connected group become blocked, with one
+    warning: a published map's closed rooms and wall interiors are unreachable anyway, and
+    a level must be one piece."""
+    labels, count = ndimage.label(~blocked)
+    if count <= 1:
+        return
+    sizes = np.bincount(labels.ravel())[1:]
+    keep = 1 + int(np.argmax(sizes))
+    pockets = (labels > 0) & (labels != keep)
+    row, col = np.argwhere(pockets)[0]
+    _warn(src, "map", f"{int(pockets.sum())} walkable cells in {count - 1} pockets walled off "
+                      f"from the rest (the first at row {row}, col {col}) are treated as blocked")
+    blocked[pockets] = True
 
 
 def _wall_rectangles(
@@ -391,3 +457,7 @@ def _origin(fld: str, origins: dict[str, str]) -> str:
 
 def _fail(src: str, fld: str, problem: str) -> NoReturn:
     raise LevelError(src, fld, problem)
+
+
+def _warn(src: str, fld: str, problem: str) -> None:
+    warnings.warn(LevelWarning(src, fld, problem), stacklevel=3)

@@ -21,6 +21,7 @@ import pygame
 import pytest
 
 import navmesh.level_fields as level_module
+from navmesh.errors import LevelWarning
 from ai.errors import StimulusError
 from ai.stimuli import Measure, Stimulus, load_stimulus
 from game.front.play import PlayGame, PlaySettings
@@ -53,8 +54,9 @@ def tripwire(world) -> Stimulus:
 
 
 def test_loading_the_plugin_lets_levels_use_its_zone_kind() -> None:
-    with pytest.raises(LevelError, match=r"\(alarm\): unknown class 'alarm'"):
-        load_level(LEVEL)
+    with pytest.warns(LevelWarning, match=r"\(alarm\): unknown class 'alarm', treated as "
+                                          "decoration"):
+        assert "alarm" not in load_level(LEVEL).zones  # a Tiled map: decoration, warned
     load_stimulus(PLUGIN)
     assert "alarm" in level_module.zone_kinds()
     level = load_level(LEVEL)
@@ -64,8 +66,8 @@ def test_loading_the_plugin_lets_levels_use_its_zone_kind() -> None:
 
 
 def test_cli_without_the_plugin_names_the_object_and_with_it_validates(capsys) -> None:
-    assert main(["validate", str(LEVEL)]) == 2
-    assert "object 8 'north-west corridor' (alarm): unknown class 'alarm'" in capsys.readouterr().err
+    assert main(["validate", str(LEVEL)]) == 0
+    assert ("stealth: warning: " in capsys.readouterr().err.split("(alarm): unknown class 'alarm'")[0])
     assert main(["validate", str(LEVEL), "--stimulus", PLUGIN]) == 0
 
 
@@ -184,8 +186,8 @@ def test_play_cli_takes_the_stimulus(tmp_path: Path, capsys) -> None:
                  "--autopilot", "maxmin", "--screenshot", str(shot)])
     assert code == 0 and shot.stat().st_size > 0
     level_module._zone_kinds[:] = list(level_module.ZONE_KINDS)  # a fresh process
-    assert main(["play", str(LEVEL), "--frames", "5"]) == 2
-    assert "unknown class 'alarm'" in capsys.readouterr().err
+    assert main(["play", str(LEVEL), "--frames", "5"]) == 0  # the alarms are decoration
+    assert "unknown class 'alarm', treated as decoration" in capsys.readouterr().err
 
 
 # ---------------------------------------------------------------------------- mechanics

@@ -77,6 +77,8 @@ def test_report_writes_every_file(swept: Path) -> None:
     assert "32 of 32 trials finished" in readme
     assert "true fraction in [0, 1]" in readme and "above 1" in readme
     assert "aggregate_partition.png" in readme and "heatmaps/" in readme
+    # it points only at what an installed wheel has: no docs/ files (the wheel ships none)
+    assert "docs/" not in readme and "python -m pydoc headless.store" in readme
 
 
 def test_trials_csv_has_one_row_per_trial_and_wall_time_last(swept: Path) -> None:

@@ -30,6 +30,7 @@ import pygame
 
 from game.scene import GuardDrawing, Scene, StaticScene
 
+from .display import choose_video_driver
 from .camera import MIN_FIT_SCALE, START_SCALE, ZOOM_STEP, Camera
 from .labels import place_labels
 from .layers import StaticLayers
@@ -45,7 +46,9 @@ from .palette import (
 from .screens import Panel, draw_panel
 
 def init_pygame() -> None:
-    """Initialise only what the front end uses (display, fonts): no audio device needed."""
+    """Initialise only what the front end uses (display, fonts): no audio device needed;
+    headless without a display (:mod:`game.front.display`)."""
+    choose_video_driver()
     pygame.display.init()
     pygame.font.init()
 

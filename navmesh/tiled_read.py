@@ -1,0 +1,115 @@
+"""Read a Tiled map's header, layers and properties — TMX (XML) or JSON — without its tilesets.
+
+A level needs only which gids are non-zero, so tilesets (embedded, ``.tsx``, ``.tsj``) and
+their images are never opened: a map whose tileset is missing, or was written by an older
+Tiled without ``tilecount`` or ``columns``, still loads. The header keys newer Tiled added
+(``infinite``, ``nextlayerid``, ``renderorder``, ``tiledversion``, ...) default as Tiled
+does. The layers are parsed by pytiled-parser's own layer readers (every data encoding and
+compression, chunks, groups, object templates). A map that is not orthogonal is refused
+before its layers are read, so an isometric, staggered or hexagonal map gets that one line
+whatever else it holds.
+"""
+
+from __future__ import annotations
+
+import json
+import xml.etree.ElementTree as etree
+from pathlib import Path
+from typing import Any, NoReturn
+
+from pytiled_parser import TiledMap
+from pytiled_parser.common_types import Size
+from pytiled_parser.parsers.json.layer import parse as parse_json_layer
+from pytiled_parser.parsers.json.properties import parse as parse_json_properties
+from pytiled_parser.parsers.tmx.layer import parse as parse_tmx_layer
+from pytiled_parser.parsers.tmx.properties import parse as parse_tmx_properties
+
+from navmesh.errors import LevelError
+from navmesh.tiled_format import is_tiled_xml
+
+__all__ = ["ORTHOGONAL", "read_map"]
+
+ORTHOGONAL = "orthogonal"
+"""The one map orientation a level can come from (its grid is the tile grid)."""
+
+_ENCODING = "utf-8"
+_LAYER_TAGS = ("layer", "objectgroup", "imagelayer", "group")
+
+
+def read_map(path: Path, source: str) -> TiledMap:
+    """The map at ``path`` with ``tilesets`` empty; a map that is not orthogonal raises
+    :class:`LevelError` (``source`` names it). Malformed input raises whatever the XML,
+    JSON or layer readers raise (the caller turns it into one line)."""
+    raw = path.read_bytes()
+    if is_tiled_xml(raw):
+        return _read_tmx(path, raw, source)
+    return _read_json(path, raw, source)
+
+
+def _read_tmx(path: Path, raw: bytes, source: str) -> TiledMap:
+    root = etree.fromstring(raw)
+    if root.tag != "map":
+        raise ValueError(f"the XML's root element is <{root.tag}>, not <map>")
+    attrib = root.attrib
+    _check_orientation(attrib.get("orientation", ORTHOGONAL), source)
+    tmap = _tiled_map(
+        path, attrib,
+        infinite=bool(int(attrib.get("infinite", "0"))),
+        layers=[parse_tmx_layer(e, _ENCODING, path.parent) for e in root if e.tag in _LAYER_TAGS],
+        size=(int(attrib["width"]), int(attrib["height"])),
+        tile=(int(attrib["tilewidth"]), int(attrib["tileheight"])),
+    )
+    properties = root.find("./properties")
+    if properties is not None:
+        tmap.properties = parse_tmx_properties(properties)
+    return tmap
+
+
+def _read_json(path: Path, raw: bytes, source: str) -> TiledMap:
+    data = json.loads(raw.decode("utf-8-sig"))
+    if not isinstance(data, dict):
+        raise ValueError("the JSON is not an object")
+    _check_orientation(data.get("orientation", ORTHOGONAL), source)
+    layers = data.get("layers") or []
+    tmap = _tiled_map(
+        path, data,
+        infinite=bool(data.get("infinite", False)),
+        layers=[parse_json_layer(layer, _ENCODING, path.parent) for layer in layers],
+        size=(int(data["width"]), int(data["height"])),
+        tile=(int(data["tilewidth"]), int(data["tileheight"])),
+    )
+    properties = data.get("properties")
+    if isinstance(properties, dict):  # Tiled < 1.2 wrote {"name": value}
+        tmap.properties = dict(properties)
+    elif properties:
+        tmap.properties = parse_json_properties(properties)
+    return tmap
+
+
+def _tiled_map(path: Path, header: Any, *, infinite: bool, layers: list, size: tuple[int, int],
+               tile: tuple[int, int]) -> TiledMap:
+    next_layer = header.get("nextlayerid")
+    return TiledMap(
+        map_file=path,
+        infinite=infinite,
+        layers=layers,
+        map_size=Size(*size),
+        next_layer_id=int(next_layer) if next_layer is not None else None,
+        next_object_id=int(header.get("nextobjectid", 1)),
+        orientation=str(header.get("orientation", ORTHOGONAL)),
+        render_order=str(header.get("renderorder", "right-down")),
+        tiled_version=str(header.get("tiledversion", "")),
+        tile_size=Size(*tile),
+        tilesets={},
+        version=str(header.get("version", "")),
+    )
+
+
+def _check_orientation(orientation: Any, source: str) -> None:
+    if orientation != ORTHOGONAL:
+        _refuse(source, f"orientation {orientation!r} is not supported; only orthogonal maps "
+                        "are (isometric, staggered and hexagonal maps have no square tile grid)")
+
+
+def _refuse(source: str, problem: str) -> NoReturn:
+    raise LevelError(source, "map", problem)
