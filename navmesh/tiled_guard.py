@@ -1,0 +1,153 @@
+"""Bounds on a Tiled JSON map, checked before pytiled-parser reads it (SPEC §8, §10).
+
+pytiled-parser opens every file a map names (external tilesets, object templates and their
+tilesets) with a plain :func:`open` and inflates every compressed layer whole, so a FIFO
+named as a tileset blocks for ever, ``/dev/zero`` is read until memory runs out and a
+12 KB zstd layer can inflate to 400 MB. :func:`guard_json_map` walks the map first with the
+same rules as every other input: each named file through :func:`navmesh.files.read_regular`,
+each layer's data through :func:`navmesh.files.inflate_bounded` against the size its tiles
+take (width × height × 4 bytes), and the map's own size against the cell limit — so a map
+that passes is one pytiled-parser reads in bounded time and memory.
+"""
+
+from __future__ import annotations
+
+import base64
+import binascii
+import json
+from pathlib import Path
+from typing import Any, NoReturn
+
+from navmesh.files import FileRefused, inflate_bounded, read_regular
+from navmesh.level import MAX_CELLS, MAX_FILE_BYTES, LevelError
+
+__all__ = ["MAX_CHUNK_CELLS", "check_map_cells", "guard_json_map"]
+
+MAX_CHUNK_CELLS = 4 * MAX_CELLS
+"""Tiles an infinite map's chunks may hold together (its content must still fit in
+:data:`navmesh.level.MAX_CELLS` cells; empty chunks around it are allowed)."""
+
+
+def guard_json_map(path: Path, source: str) -> None:
+    """Refuse, with one :class:`LevelError`, a map naming a file that is not a bounded regular
+    file, a layer whose data inflates past its tiles, or a map beyond the cell limit."""
+    doc = _json(path, source, "map")
+    if not isinstance(doc, dict):
+        return  # pytiled-parser's own error names what is wrong
+    if not doc.get("infinite"):
+        width, height = doc.get("width"), doc.get("height")
+        if _is_int(width) and _is_int(height):
+            check_map_cells(width, height, source)
+    for i, tileset in enumerate(_list(doc.get("tilesets"))):
+        if isinstance(tileset, dict) and isinstance(tileset.get("source"), str):
+            _named_file(path.parent / tileset["source"], source, f"tilesets[{i}].source")
+    chunk_cells = [0]
+    for name, layer in _layers(_list(doc.get("layers")), ""):
+        _guard_layer(layer, name, path.parent, source, chunk_cells)
+
+
+def check_map_cells(width: int, height: int, source: str, what: str = "map") -> None:
+    """The cell limit applied to a map's size in tiles before anything of that size exists."""
+    if width < 0 or height < 0:
+        _fail(source, what, f"map of {width}x{height} tiles has a negative size")
+    if width * height > MAX_CELLS:
+        _fail(source, what, f"map of {width}x{height} = {width * height} tiles exceeds the "
+                            f"limit of {MAX_CELLS} cells")
+
+
+def _guard_layer(layer: dict[str, Any], name: str, folder: Path, source: str,
+                 chunk_cells: list[int]) -> None:
+    where = f"layer {name!r}"
+    if layer.get("type") == "tilelayer":
+        compression = layer.get("compression") or ""
+        encoded = layer.get("encoding") == "base64"
+        if "data" in layer:
+            width, height = layer.get("width"), layer.get("height")
+            if _is_int(width) and _is_int(height):
+                check_map_cells(width, height, source, where)
+                _guard_data(layer["data"], encoded, compression, width * height, where, source)
+        for chunk in _list(layer.get("chunks")):
+            if not isinstance(chunk, dict):
+                continue
+            width, height = chunk.get("width"), chunk.get("height")
+            if _is_int(width) and _is_int(height):
+                chunk_cells[0] += max(width, 0) * max(height, 0)
+                if chunk_cells[0] > MAX_CHUNK_CELLS:
+                    _fail(source, where, f"chunks of more than {MAX_CHUNK_CELLS} tiles "
+                                         "in all")
+                _guard_data(chunk.get("data"), encoded, compression, width * height,
+                            where, source)
+    for obj in _list(layer.get("objects")):
+        if isinstance(obj, dict) and isinstance(obj.get("template"), str):
+            _template(folder / obj["template"], source, f"{where} object {obj.get('id')}")
+
+
+def _guard_data(data: Any, encoded: bool, compression: str, tiles: int, where: str,
+                source: str) -> None:
+    """Base64 tile data (optionally compressed) must hold exactly ``tiles`` 4-byte gids."""
+    if not encoded or not isinstance(data, str):
+        return  # a JSON list, bounded by the file's size
+    expected = 4 * tiles
+    try:
+        raw = base64.b64decode(data, validate=False)
+    except (binascii.Error, ValueError) as exc:
+        _fail(source, where, f"tile data is not valid base64 ({exc})")
+    if compression:
+        try:
+            raw = inflate_bounded(raw, compression, expected)
+        except FileRefused as refused:
+            _fail(source, where, f"tile data {refused} ({expected} bytes for the layer's "
+                                 f"{tiles} tiles)")
+    if len(raw) != expected:
+        _fail(source, where, f"tile data is {len(raw)} bytes, expected {expected} "
+                             f"(4 per tile for {tiles} tiles)")
+
+
+def _template(path: Path, source: str, where: str) -> None:
+    """An object template (``.tj``) and the tileset it names, if any."""
+    doc = _json(path, source, f"{where} template")
+    if isinstance(doc, dict) and isinstance(doc.get("tileset"), dict):
+        named = doc["tileset"].get("source")
+        if isinstance(named, str):
+            _named_file(path.parent / named, source, f"{where} template's tileset")
+
+
+def _named_file(path: Path, source: str, where: str) -> bytes:
+    try:
+        return read_regular(path, MAX_FILE_BYTES)
+    except FileRefused as refused:
+        _fail(source, where, f"{path} {refused}")
+    except FileNotFoundError:
+        _fail(source, "map", f"a file the map refers to is missing: {path}")
+    except OSError as exc:
+        _fail(source, where, f"cannot read {path} ({exc.strerror or exc})")
+
+
+def _json(path: Path, source: str, where: str) -> Any:
+    raw = _named_file(path, source, where)
+    try:
+        return json.loads(raw)
+    except (ValueError, RecursionError):
+        return None  # XML (TSX/TX) or broken: pytiled-parser reports it, the file is bounded
+
+
+def _layers(layers: list[Any], parent: str) -> Any:
+    for layer in layers:
+        if not isinstance(layer, dict):
+            continue
+        name = f"{parent}{layer.get('name', '')}"
+        yield name, layer
+        if layer.get("type") == "group":
+            yield from _layers(_list(layer.get("layers")), f"{name}/")
+
+
+def _list(value: Any) -> list[Any]:
+    return value if isinstance(value, list) else []
+
+
+def _is_int(value: Any) -> bool:
+    return isinstance(value, int) and not isinstance(value, bool)
+
+
+def _fail(source: str, where: str, problem: str) -> NoReturn:
+    raise LevelError(source, where, problem)
