@@ -95,7 +95,7 @@ def inflate_bounded(data: bytes, compression: str, limit: int) -> bytes:
             raise FileRefused(f"decompresses to up to {_mebibytes(declared)}, more than "
                               f"the limit of {_mebibytes(limit)}")
         try:
-            import zstd  # pytiled-parser's optional extra
+            import zstd  # type: ignore[import-untyped]  # pytiled-parser's optional extra
         except ImportError as exc:
             raise FileRefused("is zstd-compressed, but the zstd module is not installed "
                               "(pip install pytiled-parser[zstd])") from exc
@@ -106,6 +106,8 @@ def inflate_bounded(data: bytes, compression: str, limit: int) -> bytes:
         if len(out) > limit:  # pragma: no cover - the header bound above is exact or larger
             raise FileRefused(f"decompresses to more than {_mebibytes(limit)}")
         return out
+    if limit < 0:
+        raise ValueError("limit must be >= 0")  # zlib reads max_length 0 as "no limit"
     if compression not in ("zlib", "gzip"):
         raise FileRefused(f"unknown compression {compression!r} (zlib, gzip or zstd)")
     wbits = 31 if compression == "gzip" else 15

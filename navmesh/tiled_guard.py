@@ -35,9 +35,9 @@ def guard_json_map(path: Path, source: str) -> None:
     if not isinstance(doc, dict):
         return  # pytiled-parser's own error names what is wrong
     if not doc.get("infinite"):
-        width, height = doc.get("width"), doc.get("height")
-        if _is_int(width) and _is_int(height):
-            check_map_cells(width, height, source)
+        size = _size(doc)
+        if size is not None:
+            check_map_cells(*size, source)
     for i, tileset in enumerate(_list(doc.get("tilesets"))):
         if isinstance(tileset, dict) and isinstance(tileset.get("source"), str):
             _named_file(path.parent / tileset["source"], source, f"tilesets[{i}].source")
@@ -62,16 +62,19 @@ def _guard_layer(layer: dict[str, Any], name: str, folder: Path, source: str,
         compression = layer.get("compression") or ""
         encoded = layer.get("encoding") == "base64"
         if "data" in layer:
-            width, height = layer.get("width"), layer.get("height")
-            if _is_int(width) and _is_int(height):
-                check_map_cells(width, height, source, where)
-                _guard_data(layer["data"], encoded, compression, width * height, where, source)
+            size = _size(layer)
+            if size is not None:
+                check_map_cells(*size, source, where)
+                _guard_data(layer["data"], encoded, compression, size[0] * size[1], where,
+                            source)
         for chunk in _list(layer.get("chunks")):
             if not isinstance(chunk, dict):
                 continue
-            width, height = chunk.get("width"), chunk.get("height")
-            if _is_int(width) and _is_int(height):
-                chunk_cells[0] += max(width, 0) * max(height, 0)
+            size = _size(chunk)
+            if size is not None:
+                check_map_cells(*size, source, where)
+                width, height = size
+                chunk_cells[0] += width * height
                 if chunk_cells[0] > MAX_CHUNK_CELLS:
                     _fail(source, where, f"chunks of more than {MAX_CHUNK_CELLS} tiles "
                                          "in all")
@@ -145,8 +148,12 @@ def _list(value: Any) -> list[Any]:
     return value if isinstance(value, list) else []
 
 
-def _is_int(value: Any) -> bool:
-    return isinstance(value, int) and not isinstance(value, bool)
+def _size(thing: dict[str, Any]) -> tuple[int, int] | None:
+    """``(width, height)`` when both are integers; anything else is pytiled-parser's to report."""
+    width, height = thing.get("width"), thing.get("height")
+    if any(isinstance(v, bool) or not isinstance(v, int) for v in (width, height)):
+        return None
+    return int(width), int(height)  # type: ignore[arg-type]
 
 
 def _fail(source: str, where: str, problem: str) -> NoReturn:
