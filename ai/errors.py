@@ -8,7 +8,7 @@ from __future__ import annotations
 
 from navmesh.errors import StealthError
 
-__all__ = ["StealthError", "StimulusError", "UnknownNameError"]
+__all__ = ["StealthError", "StimulusError", "UnknownNameError", "WorkBudgetError"]
 
 
 class UnknownNameError(StealthError, ValueError):
@@ -17,3 +17,8 @@ class UnknownNameError(StealthError, ValueError):
 
 class StimulusError(StealthError, ValueError):
     """A stimulus plugin that cannot be loaded; the message is one line naming it."""
+
+
+class WorkBudgetError(StealthError, ValueError):
+    """A parameter whose work on this level's graph exceeds the budget (the message names
+    the config key), e.g. a smoothing kernel of too many node pairs."""

@@ -8,12 +8,30 @@ import numpy as np
 from scipy import sparse
 
 from navmesh.distances import RowCache
-from navmesh.graph import NodeGraph, hop_ball_pairs
+from navmesh.graph import BallTooLarge, NodeGraph, hop_ball_pairs
+
+from .errors import WorkBudgetError
+
+#: Node pairs the smoothing kernel may hold (the work budget, docs/config.md): the default
+#: radius 3 on a 10^6-cell grid holds about 2.5 × 10^7
+MAX_KERNEL_PAIRS = 50_000_000
 
 
 def kernel_matrix(graph: NodeGraph, lam: float, radius: int) -> sparse.csr_matrix:
-    """Row-normalised smoothing kernel ``λ^d / Σ λ^d`` over the hop ball of ``radius``."""
-    rows, cols, hops = hop_ball_pairs(graph, radius)
+    """Row-normalised smoothing kernel ``λ^d / Σ λ^d`` over the hop ball of ``radius``.
+
+    Part of the work budget (:mod:`game.budget`): a kernel of more than
+    :data:`MAX_KERNEL_PAIRS` node pairs is refused with a :class:`WorkBudgetError` naming
+    ``pf.kernel_radius``; a radius past the graph's diameter costs the diameter.
+    """
+    try:
+        rows, cols, hops = hop_ball_pairs(graph, radius, MAX_KERNEL_PAIRS)
+    except BallTooLarge as too_large:
+        raise WorkBudgetError(
+            f"pf.kernel_radius = {radius}: the smoothing kernel of this {graph.n}-node "
+            f"{graph.kind} graph would hold more than {too_large.pairs} node pairs "
+            f"(within {too_large.hops} hops), more than the limit of {MAX_KERNEL_PAIRS}"
+        ) from None
     weights = lam ** hops.astype(np.float64)
     n = graph.n
     totals = np.bincount(rows, weights=weights, minlength=n)
@@ -48,4 +66,4 @@ class KernelRows:
         return cols, weights
 
 
-__all__ = ["KernelRows", "kernel_block", "kernel_matrix"]
+__all__ = ["MAX_KERNEL_PAIRS", "KernelRows", "kernel_block", "kernel_matrix"]

@@ -31,6 +31,7 @@ from ai.stimuli import StimulusParams, Zone, zones_from_config
 from navmesh.level import ZONE_KINDS
 
 from .actions import ActionParams
+from .budget import check_trial_steps
 from .errors import ConfigError
 
 if TYPE_CHECKING:
@@ -156,6 +157,7 @@ def check_sections(values: Mapping[str, Any]) -> None:
         zones_from_config(_section(values, "zones"))
     except ValueError as error:
         raise ConfigError(f"zones: {error}") from None
+    check_trial_steps(values)  # the work budget (game.budget)
 
 
 def check_level(config: Config, level: Level) -> None:

@@ -322,6 +322,7 @@ def parse_preset(
     """Validate decoded preset data (see :func:`load_preset`); relative level paths are
     resolved against ``base`` (the preset file's folder); ``extra`` overrides the ``[set]``."""
     from ai import GUARD_MODES, PLAYER_POLICIES, guard_mode, player_policy
+    from game.budget import check_design_steps
     from game.config import Config
     from game.errors import ConfigError
     from game.schema import SEED, check_level
@@ -368,6 +369,11 @@ def parse_preset(
     if n_trials > MAX_TRIALS:
         raise _fail(src, "factors", f"the design has {n_trials} trials, more than the limit of "
                                     f"{MAX_TRIALS}; use fewer factor levels or seeds")
+    try:
+        check_design_steps(n_trials // math.prod(len(levels) for _, levels in factors),
+                           config.as_dict(), factors)
+    except ConfigError as error:
+        raise _fail(src, "factors" if factors else "set", str(error)) from None
 
     for mode in guards:
         try:

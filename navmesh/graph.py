@@ -382,12 +382,15 @@ def _pack(table: np.ndarray) -> Neighbours:
     return Neighbours(indptr, table[valid])
 
 
-def hop_ball_pairs(graph: NodeGraph, radius: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def hop_ball_pairs(graph: NodeGraph, radius: int, max_pairs: int | None = None,
+                   ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Every pair (x, y) with ``hops(x, y) ≤ radius``: rows, cols and hops, in row-major order.
 
     A truncated BFS from every node at once by sparse products: with ``R_k`` the pairs
-    within k hops (``R_k = R_{k-1} (I + A)``), ``Σ_{k ≤ radius} R_k`` counts
-    ``radius + 1 − hops``. Memory grows with the ball sizes, not with n².
+    within k hops (``R_k = R_{k-1} (I + A)``), ``Σ_{k ≤ K} R_k`` counts ``K + 1 − hops``.
+    Memory grows with the ball sizes, not with n²; the search stops once no ball grows (a
+    radius past the graph's diameter costs no more than the diameter), and raises
+    :class:`BallTooLarge` once more than ``max_pairs`` pairs are within reach.
     """
     from scipy.sparse import identity
 
@@ -395,16 +398,32 @@ def hop_ball_pairs(graph: NodeGraph, radius: int) -> tuple[np.ndarray, np.ndarra
     step = (graph.adjacency != 0).astype(np.int32) + identity(n, dtype=np.int32, format="csr")
     reach = identity(n, dtype=np.int32, format="csr")
     counts = reach.copy()
-    for _ in range(int(radius)):
-        reach = reach @ step
-        reach.data[:] = 1
+    rounds = 0
+    while rounds < int(radius):
+        grown = reach @ step
+        grown.data[:] = 1
+        rounds += 1
+        if max_pairs is not None and grown.nnz > max_pairs:
+            raise BallTooLarge(rounds, grown.nnz)
+        if grown.nnz == reach.nnz:  # every ball is its component: more rounds add nothing
+            counts = counts + grown
+            break
+        reach = grown
         counts = counts + reach
     counts = counts.tocsr()
     counts.sum_duplicates()
     counts.sort_indices()
     coo = counts.tocoo()
-    hops = (int(radius) + 1 - coo.data).astype(np.int64)
+    hops = (rounds + 1 - coo.data).astype(np.int64)
     return coo.row.astype(np.intp), coo.col.astype(np.intp), hops
+
+
+class BallTooLarge(ValueError):
+    """:func:`hop_ball_pairs` past its ``max_pairs``: ``pairs`` within ``hops`` hops."""
+
+    def __init__(self, hops: int, pairs: int) -> None:
+        super().__init__(f"{pairs} node pairs within {hops} hops")
+        self.hops, self.pairs = hops, pairs
 
 
 def build_graph(level: Level, abstraction: str,

@@ -31,6 +31,7 @@ from navmesh.errors import LevelError
 from navmesh.files import FileRefused, read_regular
 from navmesh.level_fields import (
     MAX_CELLS,
+    MAX_FILE_BYTES,
     MAX_SPOTS,
     ZONE_KINDS,
     _fail,
@@ -58,9 +59,6 @@ __all__ = [
     "resolve_level_path",
     "zone_kinds",
 ]
-
-MAX_FILE_BYTES = 64 * 2**20
-"""Largest level file read (64 MiB; the bundled levels are a few kB)."""
 
 
 def _bundled_levels_dir() -> Path:

@@ -19,6 +19,9 @@ from navmesh.errors import LevelError
 
 __all__ = ["MAX_CELLS", "MAX_SPOTS", "ZONE_KINDS", "register_zone_kind", "zone_kinds"]
 
+MAX_FILE_BYTES = 64 * 2**20
+"""Largest level file read (64 MiB; the bundled levels are a few kB)."""
+
 MAX_CELLS = 1_000_000
 """Largest allowed occupancy grid (rows x cols); checked before anything is rasterised."""
 

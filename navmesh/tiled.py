@@ -46,6 +46,7 @@ from shapely.geometry import Polygon, box
 from navmesh.errors import LevelError, LevelWarning
 from navmesh.level_fields import zone_kinds
 from navmesh.level_format import Level, parse_level
+from navmesh.tiled_guard import check_map_cells, guard_json_map
 from navmesh.tiled_read import read_map
 
 __all__ = ["ELLIPSE_SIDES", "load_tiled", "tiled_level_data"]
@@ -193,8 +194,10 @@ def _read_map(path: Path, source: str) -> pytiled_parser.TiledMap:
     The reader signals malformed input with whatever its code happens to raise (KeyError for
     a missing key, TypeError, ValueError, NotImplementedError for TMX templates, OSError for
     a missing tileset file, ...), so everything it raises is caught here and reported with
-    its type: the map is user input and must never end in a traceback.
+    its type: the map is user input and must never end in a traceback. The files it names
+    and its layers' data are bounded first (:mod:`navmesh.tiled_guard`).
     """
+    guard_json_map(path, source)
     try:
         return read_map(path, source)
     except LevelError:
@@ -396,6 +399,7 @@ def _grid(found: _Collected, bounds: tuple[int, int, int, int], tile: float, src
     x0, y0, x1, y1 = bounds
     if x1 <= x0 or y1 <= y0:
         _fail(src, "map", f"map of {x1 - x0}x{y1 - y0} tiles is empty")
+    check_map_cells(x1 - x0, y1 - y0, src)
     blocked = np.zeros((y1 - y0, x1 - x0), dtype=bool)
     cols, rows = _wall_tiles(found, tile)
     inside = (cols >= x0) & (cols < x1) & (rows >= y0) & (rows < y1)
