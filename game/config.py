@@ -26,6 +26,10 @@ from .schema import bound_of, check_sections
 
 DEFAULTS_PATH = Path(__file__).with_name("defaults.toml")
 
+#: keys that change what is measured, never what happens (SPEC §11): out of
+#: :meth:`Config.hash` while at their default
+HASH_NEUTRAL_PREFIX = "metrics."
+
 
 def _flatten(table: Mapping[str, Any], prefix: str = "") -> dict[str, Any]:
     flat: dict[str, Any] = {}
@@ -155,6 +159,13 @@ class Config:
         return dict(self._values)
 
     def hash(self) -> str:
-        """A short stable digest of every value: equal configs, equal hashes, any process."""
-        canonical = json.dumps(self._values, sort_keys=True, separators=(",", ":"))
+        """A short stable digest of every value: equal configs, equal hashes, any process.
+
+        A ``[metrics]`` key (what is measured, never what happens) at its default is left
+        out, so a store written before the section existed keeps its hash and resumes.
+        """
+        defaults = _default_values()
+        values = {k: v for k, v in self._values.items()
+                  if not (k.startswith(HASH_NEUTRAL_PREFIX) and defaults.get(k) == v)}
+        canonical = json.dumps(values, sort_keys=True, separators=(",", ":"))
         return hashlib.sha256(canonical.encode()).hexdigest()[:16]

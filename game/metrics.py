@@ -11,7 +11,7 @@ module, no core file edited):
 ...                column="VisitedNodes", definition="nodes any guard entered")
 >>> _ = register_metric(extra)
 >>> [m.name for m in registered_metrics()][-2:]
-['backtracks', 'visited_nodes']
+['dist_euclidean', 'visited_nodes']
 >>> unregister_metric("visited_nodes")
 >>> extra.sql_type, extra.table_columns()[0].name
 ('INTEGER', 'VisitedNodes')
@@ -19,6 +19,7 @@ module, no core file edited):
 
 from __future__ import annotations
 
+import math
 from collections import deque
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -28,15 +29,25 @@ import numpy as np
 
 if TYPE_CHECKING:
     from .distance_worker import DistanceWorker
+    from .view_cover import ViewCover
     from .world import World
 
-__all__ = ["AGGREGATES", "Counters", "Metric", "TableColumn", "register_metric",
-           "registered_metrics", "metric_names", "unregister_metric", "world_metrics"]
+__all__ = ["AGGREGATES", "BACKTRACK_RULES", "COVERAGE_RULES", "Counters", "DISTANCE_RULES",
+           "Metric", "RECENT_ENTRIES", "TableColumn", "register_metric", "registered_metrics",
+           "metric_names", "unregister_metric", "world_metrics"]
 
 #: how a metric's per-trial values become one Table 3 cell: ``mean`` of the values, or
 #: ``rate`` = the share of trials where it is true (a mean of 1/0, on a fraction axis)
 AGGREGATES = ("mean", "rate")
 _SQL_TYPES = {"bool": "INTEGER", "int": "INTEGER", "float": "REAL"}
+
+#: ``metrics.backtracks = "entries"``: the paper's "revisiting recent locations (e.g.
+#: within the last N = 5 steps)" (guard-ai-composite-potential-fields.tex, line 328)
+RECENT_ENTRIES = 5
+#: the values of the ``[metrics]`` keys (SPEC §11), today's definition first (the default)
+COVERAGE_RULES = ("visited", "seen", "per_guard")
+BACKTRACK_RULES = ("targets", "entries")
+DISTANCE_RULES = ("path", "euclidean")
 
 
 @dataclass
@@ -49,6 +60,16 @@ class Counters:
     backtracks: int = 0
     dist_sum: float = 0.0
     dist_samples: int = 0
+    #: the other definitions (SPEC §11 ``metrics.*``), counted in every trial: guard entries
+    #: into one of that guard's last :data:`RECENT_ENTRIES` entered nodes; straight-line
+    #: player-to-nearest-guard distances; per guard, the nodes its centre entered
+    entry_backtracks: int = 0
+    euclid_sum: float = 0.0
+    euclid_samples: int = 0
+    guard_covered: list[np.ndarray] = field(default_factory=list)
+    recent_entries: list[deque[int]] = field(default_factory=list)
+    #: the nodes inside a guard's view at some AI tick (set by the world)
+    view_cover: ViewCover | None = None
     #: per node: ever entered by a guard; guard entries; HP the player lost there
     covered: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=bool))
     visits: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=np.int64))
@@ -118,10 +139,41 @@ class Counters:
         if self.capture_time is None:
             self.capture_time = t
 
-    def count_visit(self, node: int) -> None:
-        """A guard's centre entered ``node``."""
+    def count_visit(self, node: int, guard: int = 0) -> None:
+        """Guard number ``guard``'s centre entered ``node`` (a backtrack by entries when
+        ``node`` is among the last :data:`RECENT_ENTRIES` nodes it entered)."""
         self.visits[node] += 1
         self.covered[node] = True
+        while len(self.guard_covered) <= guard:
+            self.guard_covered.append(np.zeros(len(self.covered), dtype=bool))
+            self.recent_entries.append(deque(maxlen=RECENT_ENTRIES))
+        self.guard_covered[guard][node] = True
+        recent = self.recent_entries[guard]
+        if node in recent:
+            self.entry_backtracks += 1
+        recent.append(node)
+
+    def sample_euclidean(self, player: tuple[float, float],
+                         guards: list[tuple[float, float]]) -> None:
+        """One physics step's straight-line distance from the player to the nearest guard."""
+        if guards:
+            px, py = player
+            self.euclid_sum += min(math.hypot(x - px, y - py) for x, y in guards)
+            self.euclid_samples += 1
+
+    def mean_euclidean(self) -> float | None:
+        """The mean of the straight-line samples (None: no guard was ever in play)."""
+        return self.euclid_sum / self.euclid_samples if self.euclid_samples else None
+
+    def per_guard_coverage(self) -> float:
+        """The sum over guards of the share of nodes each one's centre entered (up to the
+        number of guards)."""
+        n = len(self.covered)
+        return sum(int(c.sum()) for c in self.guard_covered) / n if n else 0.0
+
+    def seen_coverage(self) -> float | None:
+        """The share of nodes inside some guard's view at an AI tick (None: not tracked)."""
+        return None if self.view_cover is None else self.view_cover.share()
 
     def count_arrival(self, history: deque[int], target: int) -> None:
         """A guard reached its decided ``target``: a backtrack if it is among its last
@@ -209,6 +261,32 @@ def _round(value: float | None) -> float | None:
     return None if value is None else round(value, 6)
 
 
+def _visited(w: World) -> float:
+    return float(w.m.covered.mean()) if w.graph.n else 0.0
+
+
+#: every definition of the keyed metrics (SPEC §11), by the value of its ``metrics.*`` key
+_COVERAGE: dict[str, Callable[[World], float | None]] = {
+    "visited": _visited,
+    "seen": lambda w: w.m.seen_coverage(),
+    "per_guard": lambda w: w.m.per_guard_coverage(),
+}
+_BACKTRACKS: dict[str, Callable[[World], int]] = {
+    "targets": lambda w: w.m.backtracks,
+    "entries": lambda w: w.m.entry_backtracks,
+}
+_DISTANCE: dict[str, Callable[[World], float | None]] = {
+    "path": lambda w: w.m.mean_distance(),
+    "euclidean": lambda w: w.m.mean_euclidean(),
+}
+
+
+def _keyed(table: dict[str, Callable[[World], Any]], key: str) -> Callable[[World], Any]:
+    """The metric as the world's ``metrics.<key>`` defines it (today's without the key)."""
+    first = next(iter(table))
+    return lambda w: table[w.config.section("metrics").get(key, first)](w)
+
+
 _CORE: tuple[Metric, ...] = (
     Metric("captured", lambda w: w.m.captures > 0, kind="bool", scenarios=("capture",),
            aggregate="rate", column="CaptureRate", unit="fraction",
@@ -220,21 +298,43 @@ _CORE: tuple[Metric, ...] = (
            "rate 0.04)"),
     Metric("captures", lambda w: w.m.captures, kind="int", column="CapturesInTime",
            definition="captures in 60 s (the player respawns after each)"),
-    Metric("coverage", lambda w: float(w.m.covered.mean()) if w.graph.n else 0.0,
+    Metric("coverage", _keyed(_COVERAGE, "coverage"),
            column="CoverageRate", unit="fraction",
-           definition="fraction of walkable nodes (cells or triangles) any guard entered, in "
-           "[0, 1]"),
-    Metric("avg_guard_player_dist",
-           lambda w: w.m.mean_distance(),
+           definition="by `metrics.coverage` (default `visited`: the fraction of walkable "
+           "nodes (cells or triangles) any guard entered, in [0, 1]); see coverage_*"),
+    Metric("avg_guard_player_dist", _keyed(_DISTANCE, "distance"),
            column="AvgGuardPlayerDist", title="AvgGuard–PlayerDist", unit="world units",
-           definition="mean over physics steps of the shortest-path distance (world units) "
-           "from the player's node to the closest guard's node"),
+           definition="by `metrics.distance` (default `path`: the mean over physics steps of "
+           "the shortest-path distance (world units) from the player's node to the closest "
+           "guard's node); see dist_*"),
     Metric("first_detect_time", lambda w: _round(w.m.first_detect_time),
            column="FirstDetectTime", unit="s", censor=True, unit_in_title=True,
            definition="time of the first sighting (s); **a trial without one counts as its "
            "full duration** (the paper's RandomWalk 46 ± 23 s implies the same)"),
-    Metric("backtracks", lambda w: w.m.backtracks, kind="int", column="BacktrackCount",
-           definition="guard moves to a node among that guard's last 5 nodes"),
+    Metric("backtracks", _keyed(_BACKTRACKS, "backtracks"), kind="int",
+           column="BacktrackCount",
+           definition="by `metrics.backtracks` (default `targets`: guard moves to a decided "
+           "node among that guard's last 5 nodes); see backtracks_*"),
+    # Every definition at once, whatever the keys say (stored and in trials.csv, not in
+    # Table 3), so one store answers each of them.
+    Metric("coverage_visited", _visited, unit="fraction",
+           definition="fraction of walkable nodes any guard's centre entered"),
+    Metric("coverage_seen", _COVERAGE["seen"], unit="fraction",
+           definition="fraction of walkable nodes inside some active guard's view (range "
+           "scaled by the node's zone, cone, clear line) at some AI tick"),
+    Metric("coverage_per_guard", _COVERAGE["per_guard"], unit="fraction",
+           definition="sum over guards of the fraction of nodes each guard's centre entered "
+           "(up to the number of guards)"),
+    Metric("backtracks_targets", _BACKTRACKS["targets"], kind="int",
+           definition="guard arrivals at a decided target among that guard's last 5 targets"),
+    Metric("backtracks_entries", _BACKTRACKS["entries"], kind="int",
+           definition="guard entries into a node among the last 5 nodes that guard entered"),
+    Metric("dist_path", _DISTANCE["path"], unit="world units",
+           definition="mean over physics steps of the shortest-path distance from the "
+           "player's node to the closest guard's node"),
+    Metric("dist_euclidean", _DISTANCE["euclidean"], unit="world units",
+           definition="mean over physics steps of the straight-line distance from the "
+           "player to the closest active guard"),
 )
 
 _REGISTRY: dict[str, Metric] = {m.name: m for m in _CORE}
@@ -259,7 +359,8 @@ def unregister_metric(name: str) -> None:
 
 
 def registered_metrics() -> tuple[Metric, ...]:
-    """Every metric in registration order (the SPEC §7 ones first)."""
+    """Every metric in registration order (the SPEC §7 ones first, then every definition
+    of the SPEC §11 keyed ones)."""
     return tuple(_REGISTRY.values())
 
 

@@ -33,6 +33,7 @@ from navmesh.level import ZONE_KINDS
 from .actions import ActionParams
 from .budget import check_trial_steps
 from .errors import ConfigError
+from .metrics import BACKTRACK_RULES, COVERAGE_RULES, DISTANCE_RULES
 
 if TYPE_CHECKING:
     from navmesh.level import Level
@@ -89,6 +90,15 @@ SCENARIO: Mapping[str, Bound] = {
 }
 """``[scenario.<name>]``: the same keys for every scenario."""
 
+# ---- [metrics] (SPEC §11): which definition the keyed metrics take (game.metrics); they
+# change what is measured, never what happens
+METRICS: Mapping[str, Bound] = {
+    "coverage": OneOf(COVERAGE_RULES),
+    "backtracks": OneOf(BACKTRACK_RULES),
+    "distance": OneOf(DISTANCE_RULES),
+}
+"""``[metrics]``: the definition of coverage, backtracks and distance."""
+
 _PLAYER_OWN = {k: v for k, v in PlayerParams.bounds.items()
                if k not in ("guard_speed", "player_speed")}  # those come from [world]
 
@@ -106,6 +116,7 @@ _SECTIONS: Mapping[str, Mapping[str, Bound]] = {
     "player": _PLAYER_OWN,
     # beyond the paper (docs/ai.md): each section's switch plus its parameter class
     **{name: {"enabled": FLAG, **cls.bounds} for name, cls in _TEAM_RULES.items()},
+    "metrics": METRICS,
 }
 
 

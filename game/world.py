@@ -27,6 +27,7 @@ from .schema import check_level
 from .senses import RANGE_EPS, Senses
 from .spawns import guard_spawn_nodes, level_start_node, respawn_node, start_node
 from .team import TeamRules
+from .view_cover import ViewCover
 from .zones import ZoneMap
 
 SCENARIOS = ("capture", "fixed")
@@ -101,6 +102,9 @@ class World(PlayerActions):
         self.player_input: tuple[float, float] | None = None
         self.on_tick: Callable[[World], None] | None = None
         self.m: Counters = Counters.for_nodes(self.graph.n)
+        # metrics.coverage = "seen": a node is seen as a player standing on it would be
+        self.m.view_cover = ViewCover(self.graph, self.senses,
+                                      self.view_range * self.view_scale_at)
 
         guard_speed = self.guard_speed = float(w["guard_speed"])
         player_speed = float(w["player_speed"]) * float(s["player_speed_scale"])
@@ -117,8 +121,8 @@ class World(PlayerActions):
         self.guard_ai.reset(self.graph, guard_rng, len(self.guards))
         if self.player_policy is not None:
             self.player_policy.reset(self.graph, player_rng)
-        for guard in self.guards:
-            self._enter_node(guard, guard.node)
+        for i, guard in enumerate(self.guards):
+            self._enter_node(guard, guard.node, i)
             guard.history.append(guard.node)
 
         # Stimuli (ai.stimuli): world events become field layers for the guard AI's hooks.
@@ -225,12 +229,12 @@ class World(PlayerActions):
                     before[-1] = self.player.pos
 
         speeds = [g.speed for g in self.guards] + [player_speed]
-        for agent, start, speed in zip(self.guards + [self.player], before, speeds):
+        for i, (agent, start, speed) in enumerate(zip(self.guards + [self.player], before, speeds)):
             if walk.settle(agent, start, speed, self.stuck_timeout) and agent is not self.player:
                 self.m.count_arrival(agent.history, agent.target)  # the player is not scored
             node = self.graph.node_near(*agent.pos, agent.node)
             if node != agent.node:
-                self._enter_node(agent, node)
+                self._enter_node(agent, node, i)
         self.player_moved = self.player.pos != before[-1]
         if sprint and self.player_moved:
             self._sprinted = True  # footsteps: the player moved while sprinting this tick
@@ -245,13 +249,13 @@ class World(PlayerActions):
         """End the trial now (a script that has seen what it waited for)."""
         self.done = True
 
-    def _enter_node(self, agent: Agent, node: int) -> None:
+    def _enter_node(self, agent: Agent, node: int, index: int) -> None:
+        """``agent`` (guard number ``index``, or the player) now stands on ``node``."""
         agent.node = node
         if agent is not self.player:
-            self.m.count_visit(node)
+            self.m.count_visit(node, index)
             if node in self._watched and agent.active:
-                guard = next(i for i, g in enumerate(self.guards) if g is agent)
-                self.events.append(Event("guard_on", node, self.t, {"guard": guard}))
+                self.events.append(Event("guard_on", node, self.t, {"guard": index}))
 
     def _sense(self) -> None:
         """Vision, attack damage, distance and detection metrics for the current positions."""
@@ -266,8 +270,9 @@ class World(PlayerActions):
         self.attackers = sum(1 for g in self.guards if g.active and self.senses.perceives(
             g.pos, None, ppos, self.attack_range, line_of_sight=self.attack_los))
         if self.step_index > 0:
-            self.m.sample_distance(self.graph, self.player.node,
-                                   [g.node for g in self.guards if g.active])
+            active = [g for g in self.guards if g.active]
+            self.m.sample_distance(self.graph, self.player.node, [g.node for g in active])
+            self.m.sample_euclidean(ppos, [g.pos for g in active])
 
     def _captured(self) -> None:
         self.m.count_capture(self.t)
@@ -290,6 +295,8 @@ class World(PlayerActions):
         self.team.before_tick(self)
         self.tick_events = self.events
         view = self.view()
+        if self.m.view_cover is not None:
+            self.m.view_cover.observe(self.guards)
         self.stimuli.tick(view, dt)  # before the guard AI's tick, so FSM reacts to new layers
         self.team.after_stimuli(self)
         self.guard_ai.tick(view, dt)

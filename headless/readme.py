@@ -10,12 +10,45 @@ import json
 from collections.abc import Mapping, Sequence
 from pathlib import Path
 
+from game.config import Config
+from game.metrics import registered_metrics
+
 from .paper import is_paper_design
 from .stats import BOOTSTRAP_RESAMPLES, BOOTSTRAP_SEED
 from .store import STORE_NAME
 from .tables import table_columns
 
-__all__ = ["readme"]
+__all__ = ["metric_rules", "readme"]
+
+
+def metric_rules(design: Mapping[str, object]) -> dict[str, str]:
+    """The ``[metrics]`` keys (SPEC §11) a design's trials ran with: its ``set`` or the
+    defaults."""
+    fixed = design.get("set") or {}
+    assert isinstance(fixed, Mapping)
+    defaults = Config.defaults().section("metrics")
+    return {name: str(fixed.get(f"metrics.{name}", value)) for name, value in defaults.items()}
+
+
+_COVERAGE = {
+    "visited": "* **Coverage is a true fraction in [0, 1].** The paper reports partition coverage "
+               "above 1 (e.g. PF 1.72), which cannot be a fraction of nodes; ours counts each node "
+               "once, so partition and grid coverage are on the same scale but not comparable to "
+               "the paper's partition column.",
+    "seen": "* **Coverage is the fraction of nodes seen** (`metrics.coverage = seen`): inside "
+            "some guard's view at an AI tick, in [0, 1].",
+    "per_guard": "* **Coverage is summed over guards** (`metrics.coverage = per_guard`): each "
+                 "guard's fraction of nodes entered, summed, so it can exceed 1 as the paper's "
+                 "partition column does.",
+}
+#: the columns of every definition (game.metrics)
+_DEFINED = ("coverage_", "backtracks_", "dist_")
+_DISTANCE = {
+    "path": "* Distances are shortest-path distances on the node graph in world units (1 unit = 1 "
+            "grid cell), on both abstractions.",
+    "euclidean": "* Distances are straight-line distances between the player's and the nearest "
+                 "guard's bodies in world units (`metrics.distance = euclidean`).",
+}
 
 
 def readme(directory: Path, meta: Mapping[str, str], done: int, skipped_heat: int, failed: int,
@@ -53,6 +86,7 @@ def readme(directory: Path, meta: Mapping[str, str], done: int, skipped_heat: in
         "abstraction × guard mode × player policy (`table.csv` also has n per cell) |",
     ]
     paper = is_paper_design(design)
+    rules = metric_rules(design)
     for name in names:
         if name.startswith("aggregate_"):
             lines.append(f"| `{name}` | the paper's *Aggregated performance* figure: bars "
@@ -84,6 +118,11 @@ def readme(directory: Path, meta: Mapping[str, str], done: int, skipped_heat: in
         "|---|---|---|",
         *(f"| {c.title} | {c.scenario} | {c.metric.definition} |" for c in table_columns()),
         "",
+        "`trials.csv` also has every definition of the keyed metrics (SPEC §11; the keys "
+        f"here: {', '.join(f'`metrics.{k} = {v}`' for k, v in rules.items())}): "
+        + "; ".join(f"`{m.name}` = {m.definition}" for m in registered_metrics()
+                    if m.column is None and m.name.startswith(_DEFINED)) + ".",
+        "",
         "Each cell: mean ± sample standard deviation (ddof = 1) [95 % percentile-bootstrap "
         f"confidence interval of the mean, {BOOTSTRAP_RESAMPLES} resamples, generator "
         f"`PCG64(SeedSequence([{BOOTSTRAP_SEED}, crc32(label)]))`, label = "
@@ -95,14 +134,10 @@ def readme(directory: Path, meta: Mapping[str, str], done: int, skipped_heat: in
         "",
         "## Where these numbers differ from the paper",
         "",
-        "* **Coverage is a true fraction in [0, 1].** The paper reports partition coverage "
-        "above 1 (e.g. PF 1.72), which cannot be a fraction of nodes; ours counts each node "
-        "once, so partition and grid coverage are on the same scale but not comparable to the "
-        "paper's partition column.",
+        _COVERAGE.get(rules["coverage"], _COVERAGE["visited"]),
         "* CaptureTime and FirstDetectTime are censored at the trial duration (see above), not "
         "averaged over the trials where the event happened.",
-        "* Distances are shortest-path distances on the node graph in world units (1 unit = 1 "
-        "grid cell), on both abstractions.",
+        _DISTANCE.get(rules["distance"], _DISTANCE["path"]),
         "* The paper gives mean ± std only; the bootstrap intervals are ours.",
     ]
     if skipped_heat:

@@ -42,7 +42,7 @@ from .figures import FORMATS, write_aggregate
 from .heatmaps import HeatSums, figure_count, write_heatmaps
 from .paper import is_paper_design, paper_table3
 from .progress import Progress
-from .readme import readme
+from .readme import metric_rules, readme
 from .session_report import write_session_report
 from .stats import BOOTSTRAP_RESAMPLES, BOOTSTRAP_SEED, Stat, bootstrap_ci, summarise
 from .store import IDENTITY, STORE_NAME, ResultStore
@@ -99,7 +99,7 @@ def write_report(directory: str | Path, *, figures: bool = True,
     written.append(path)
 
     rows = table_rows(trials, design.get("abstractions"))
-    write_table(rows, directory, len(trials))
+    write_table(rows, directory, len(trials), metric_rules(design)["coverage"])
     written += [directory / "table.md", directory / "table.csv"]
 
     failed_path = directory / "failed.csv"

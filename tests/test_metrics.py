@@ -45,7 +45,11 @@ def visited_metric() -> Iterator[Metric]:
 
 def test_core_registry_is_the_spec_metrics_in_order() -> None:
     assert metric_names() == ("captured", "capture_time", "captures", "coverage",
-                              "avg_guard_player_dist", "first_detect_time", "backtracks")
+                              "avg_guard_player_dist", "first_detect_time", "backtracks",
+                              # SPEC §11: every definition of the keyed ones
+                              "coverage_visited", "coverage_seen", "coverage_per_guard",
+                              "backtracks_targets", "backtracks_entries", "dist_path",
+                              "dist_euclidean")
     with pytest.raises(ValueError, match="already registered"):
         register_metric(Metric("captures", lambda w: 0))
     with pytest.raises(ValueError, match="core metric"):
