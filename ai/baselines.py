@@ -145,6 +145,7 @@ class ScriptedGuards(GuardAI):
         stimulus_source = (
             int(np.argmin(self._extra)) if self._extra.size and self._extra.min() < 0 else None
         )
+        heard = self._sighting_heard(sighting, view.guard_nodes)
         active = view.guard_active
         for i, gs in enumerate(self.guards):
             if active is not None and not active[i]:
@@ -164,7 +165,7 @@ class ScriptedGuards(GuardAI):
                 self._enter(gs, CHASE, node)
                 continue
             info_node = None
-            if sighting is not None and c.sighting_information >= c.info_threshold:
+            if sighting is not None and heard[i]:
                 info_node = sighting
             elif stimulus_source is not None and -self._extra[node] >= c.info_threshold:
                 info_node = stimulus_source
@@ -184,6 +185,24 @@ class ScriptedGuards(GuardAI):
                 gs.time_in_state >= c.return_max - _TIME_EPS or node == gs.route_node
             ):
                 self._enter(gs, PATROL, node)
+
+    def _sighting_heard(self, sighting: int | None, guard_nodes: np.ndarray) -> np.ndarray:
+        """Per guard: whether the sighting's information reaches ``info_threshold`` for it.
+
+        ``team``: everyone, when ``sighting_information`` does. ``local``: a guard whose node
+        is within the hops where ``sighting_information × information_falloff^hops`` does
+        (one breadth-first search bounded at that depth, from the sighting node).
+        """
+        c = self.config
+        n = len(guard_nodes)
+        if sighting is None or c.sighting_information < c.info_threshold:
+            return np.zeros(n, dtype=bool)
+        if c.investigate == "team":
+            return np.ones(n, dtype=bool)
+        inside, _ = self.graph.hop_ball(sighting, _information_depth(
+            c.sighting_information, c.information_falloff, c.info_threshold))
+        at = np.searchsorted(inside, guard_nodes)
+        return (at < len(inside)) & (inside[np.minimum(at, len(inside) - 1)] == guard_nodes)
 
     @staticmethod
     def _enter(gs: GuardState, state: str, node: int) -> None:
@@ -251,13 +270,21 @@ class FSMGuards(ScriptedGuards):
 
 
 class StalenessGuards(ScriptedGuards):
-    """Staleness baseline: patrols to the stalest node (time since any guard stood there).
+    """Staleness baseline: patrols to where the team has not looked (``model``) for longest.
 
-    Staleness grows by ``increment`` per second of AI tick (``increment × dt``) and is reset
-    to 0 on every active guard's node at each tick and on a guard's node whenever it
-    decides (so cells a guard walks through between ticks count as visited). The target is
-    the stalest reachable node that no other guard is heading for; ties are drawn with the
-    trial's generator.
+    Staleness grows by ``increment`` per second of AI tick (``increment × dt``) everywhere
+    and is reset to 0 on every active guard's node at each tick and on a guard's node
+    whenever it decides (so cells a guard walks through between ticks count). Then:
+
+    * ``model = "node"`` (the rule before SPEC §11): the target is the stalest reachable
+      node that no other guard is heading for; ties are drawn with the trial's generator.
+      Every node no guard stood on is equally stale, so this is close to the FSM's patrol.
+    * ``model = "view"`` (Al Enezi & Verbrugge 2020; docs/ai.md): staleness is also reset on
+      every node a guard sees at the tick (``view.guard_sight``, computed by the world). The
+      target maximises ``staleness − distance_weight × path distance`` over the reachable
+      nodes farther than ``spread_radius`` from every other guard's target (ties drawn with
+      the generator), and a target that any guard sees is done: the guard picks the next
+      at its next decision.
     """
 
     mode = "staleness"
@@ -266,25 +293,78 @@ class StalenessGuards(ScriptedGuards):
     def reset(self, graph: NodeGraph, rng: np.random.Generator, n_guards: int) -> None:
         super().reset(graph, rng, n_guards)
         self.staleness = np.zeros(graph.n)
+        self.by_view = self.config.model == "view"  # type: ignore[attr-defined]
+
+    def wants_guard_sight(self) -> bool:
+        """The view model resets staleness on what the guards see."""
+        return self.config.model == "view"  # type: ignore[attr-defined]
 
     def tick(self, view: WorldView, dt: float) -> None:
-        """Staleness grows by ``increment × dt`` and resets under the guards; then the FSM tick."""
+        """Staleness grows by ``increment × dt`` and resets under (view: in sight of) the
+        guards; then the FSM tick."""
         self.staleness += self.config.increment * dt  # type: ignore[attr-defined]
         self.staleness[active_guard_nodes(view)] = 0.0
+        if self.by_view and view.guard_sight is not None:
+            sights = [s for s in view.guard_sight if len(s)]
+            if sights:
+                self.staleness[np.concatenate(sights)] = 0.0
+            for gs in self.guards:  # a target in sight has been looked at: pick the next
+                if gs.target is not None and self.staleness[gs.target] == 0.0:
+                    gs.target = None
         super().tick(view, dt)
 
     def _visit(self, node: int) -> None:
         self.staleness[node] = 0.0
 
     def _patrol_target(self, i: int, node: int) -> int:
-        values = np.where(self.graph.reachable_from(node), self.staleness, -np.inf)
+        taken = self._taken_targets(i)
+        if not self.by_view:
+            values = np.where(self.graph.reachable_from(node), self.staleness, -np.inf)
+        else:
+            c = self.config
+            distance = self.graph.dist_from(node)  # the row the step along the path reads too
+            values = np.where(np.isfinite(distance),
+                              self.staleness - c.distance_weight * distance,  # type: ignore[attr-defined]
+                              -np.inf)
+            values = self._spread(values, taken, c.spread_radius)  # type: ignore[attr-defined]
         values[node] = -np.inf
-        values[self._taken_targets(i)] = -np.inf
+        values[taken] = -np.inf
         best = values.max()
         if not np.isfinite(best):
             return node
         stalest = np.flatnonzero(values >= best - 1e-9)
         return int(stalest[self.rng.integers(len(stalest))])
+
+    def _spread(self, values: np.ndarray, taken: list[int], radius: float) -> np.ndarray:
+        """``values`` with the nodes within ``radius`` of another guard's target ruled out,
+        unless that rules out everything (a small level, many guards)."""
+        if not taken or radius <= 0:
+            return values
+        pos = self.graph.positions
+        near = np.zeros(self.graph.n, dtype=bool)
+        for t in taken:
+            d = pos - pos[t]
+            near |= d[:, 0] * d[:, 0] + d[:, 1] * d[:, 1] <= radius * radius
+        spread = np.where(near, -np.inf, values)
+        return spread if np.isfinite(spread).any() else values
+
+
+def _information_depth(strength: float, falloff: float, threshold: float) -> int | None:
+    """The largest hop count d with ``strength × falloff^d ≥ threshold`` (None: any depth).
+
+    >>> _information_depth(5.0, 0.9, 1.0), _information_depth(5.0, 0.5, 5.0), _information_depth(5.0, 1.0, 1.0)
+    (15, 0, None)
+    """
+    if threshold <= 0 or falloff >= 1.0:
+        return None
+    if falloff <= 0.0:
+        return 0
+    depth = max(0, int(np.floor(np.log(threshold / strength) / np.log(falloff))))
+    while strength * falloff ** (depth + 1) >= threshold:  # the floor may round either way
+        depth += 1
+    while depth > 0 and strength * falloff**depth < threshold:
+        depth -= 1
+    return depth
 
 
 __all__ = [

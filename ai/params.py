@@ -24,7 +24,7 @@ from collections.abc import Mapping
 from dataclasses import dataclass, fields
 from typing import Any, ClassVar, TypeVar
 
-from .bounds import ANY_NUMBER, COUNT, FLAG, FRACTION, NON_NEGATIVE, POSITIVE, UNIT, Bound, Range
+from .bounds import ANY_NUMBER, COUNT, FLAG, FRACTION, NON_NEGATIVE, POSITIVE, UNIT, Bound, OneOf, Range
 
 _P = TypeVar("_P", bound="_Params")
 
@@ -115,6 +115,14 @@ class PFParams(_Params):
             raise ValueError("PFParams: w_C_patrol + w_N_patrol must be > 0")
 
 
+INVESTIGATE_RULES = ("team", "local")
+"""``fsm.investigate`` / ``staleness.investigate`` (first: the rule before SPEC §11)."""
+
+STALENESS_MODELS = ("node", "view")
+"""``staleness.model``: ``node`` resets staleness only where a guard stands; ``view`` on every
+node a guard sees (Al Enezi & Verbrugge 2020; docs/ai.md)."""
+
+
 @dataclass(frozen=True)
 class FSMParams(_Params):
     """FSM guards (paper Table 2; SPEC §4). Times in seconds."""
@@ -127,6 +135,12 @@ class FSMParams(_Params):
     chase_max: float = 10.0
     return_max: float = 5.0
     r_edge_factor: float = 2.5  # partition step horizon = factor × mean edge length
+    #: who a sighting sends to Investigate (SPEC §11): "team" = every guard, whatever its
+    #: distance; "local" = a guard where the sighting's information at its own node,
+    #: sighting_information × information_falloff^hops, reaches info_threshold
+    investigate: str = "team"
+    #: "local" only: the sighting's information falls off by this factor per hop (the PF's gamma_I)
+    information_falloff: float = 0.9
 
     bounds = {
         "info_threshold": NON_NEGATIVE,
@@ -136,16 +150,27 @@ class FSMParams(_Params):
         "chase_max": NON_NEGATIVE,
         "return_max": NON_NEGATIVE,
         "r_edge_factor": POSITIVE,
+        "investigate": OneOf(INVESTIGATE_RULES),
+        "information_falloff": FRACTION,
     }
 
 
 @dataclass(frozen=True)
 class StalenessParams(FSMParams):
-    """Staleness guards: the FSM's parameters plus the staleness growth per second of AI tick."""
+    """Staleness guards: the FSM's parameters, the staleness growth per second of AI tick, and
+    the patrol rule (``model``; ``distance_weight`` and ``spread_radius`` apply to ``view``)."""
 
     increment: float = 1.0
+    model: str = "view"
+    #: view: a patrol target scores staleness − distance_weight × path distance (seconds of
+    #: staleness per world unit; 0.5 = one second of walking at the default guard speed)
+    distance_weight: float = 0.5
+    #: view: no target within this distance (world units) of another guard's target
+    spread_radius: float = 4.0
 
-    bounds = {**FSMParams.bounds, "increment": NON_NEGATIVE}
+    bounds = {**FSMParams.bounds, "increment": NON_NEGATIVE,
+              "model": OneOf(STALENESS_MODELS), "distance_weight": Range(0.0, 100.0),
+              "spread_radius": NON_NEGATIVE}
 
 
 @dataclass(frozen=True)
@@ -176,4 +201,5 @@ class PlayerParams(_Params):
     }
 
 
-__all__ = ["PFParams", "FSMParams", "StalenessParams", "PlayerParams"]
+__all__ = ["PFParams", "FSMParams", "StalenessParams", "PlayerParams", "INVESTIGATE_RULES",
+           "STALENESS_MODELS"]

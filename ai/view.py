@@ -54,6 +54,9 @@ class WorldView:
     zones: Mapping[str, np.ndarray] = field(default_factory=dict)
     #: guards still in play (a guard taken down is inactive)
     guard_active: np.ndarray | None = None
+    #: per guard, the nodes it sees at this AI tick (filled only at AI ticks and only for a
+    #: mode whose :meth:`GuardAI.wants_guard_sight` is true); None: not computed
+    guard_sight: tuple[np.ndarray, ...] | None = None
 
     @property
     def n_guards(self) -> int:
@@ -163,6 +166,11 @@ class GuardAI(ABC):
         now, and the identity is that of the arrays."""
         fields = self.fields()
         return tuple(id(a) for a in fields.values()), lambda: fields
+
+    def wants_guard_sight(self) -> bool:
+        """Whether the mode reads :attr:`WorldView.guard_sight` at its AI ticks (default: no,
+        so the world does not compute it)."""
+        return False
 
     def hears_stimuli(self) -> bool:
         """Whether the stimuli's information layer reaches this mode (default: no).

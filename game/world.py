@@ -21,6 +21,7 @@ from . import trace
 from .actions import ActionParams, PlayerActions, Refused
 from .agents import Agent, Locomotion, build_space
 from .config import Config
+from .guard_sight import GuardSight
 from .health import Health
 from .metrics import Counters, world_metrics
 from .schema import check_level
@@ -134,6 +135,9 @@ class World(PlayerActions):
             self.stimuli.add(factory())
         # Beyond the paper (game.team): graded perception, alert phases, radio, roles.
         self.team = TeamRules.build(config, len(self.guards), self.stimuli)
+        # What each guard sees, for a mode that patrols by sight (staleness.model = "view")
+        self.guard_sight = (GuardSight(self.graph, self.senses, self.view_range * self.view_scale_at,
+                                       level.walls) if self.guard_ai.wants_guard_sight() else None)
         self.stimuli.refresh()
         self._watched = self.stimuli.marked_nodes()
 
@@ -299,6 +303,8 @@ class World(PlayerActions):
             self.m.view_cover.observe(self.guards)
         self.stimuli.tick(view, dt)  # before the guard AI's tick, so FSM reacts to new layers
         self.team.after_stimuli(self)
+        if self.guard_sight is not None:
+            view.guard_sight = self.guard_sight.seen(self.guards)
         self.guard_ai.tick(view, dt)
         self._watched = self.stimuli.marked_nodes()
         self.events = []
