@@ -25,6 +25,7 @@ from dataclasses import dataclass, fields
 from typing import Any, ClassVar, TypeVar
 
 from .bounds import ANY_NUMBER, COUNT, FLAG, FRACTION, NON_NEGATIVE, POSITIVE, UNIT, Bound, Range
+from .bounds import OneOf
 
 _P = TypeVar("_P", bound="_Params")
 
@@ -163,6 +164,10 @@ class PlayerParams(_Params):
     safety_penalty: float = 4.0
     r_edge_factor: float = 2.5  # partition step horizon of SafetyGraph
     tie_eps: float = 1e-9
+    #: SafetyGraph's goal rule: "escape" (ours: the farthest node kept ``safety_margin`` safe,
+    #: re-planned at every decision) or "paper" (the paper's text only: the safest node, A*
+    #: with a Euclidean heuristic, margin 0, re-planned once per decision tick); ai/players.py
+    safetygraph_goal: str = "escape"
 
     bounds = {
         "maxmin_depth": Range(1, 6, integer=True),
@@ -173,6 +178,7 @@ class PlayerParams(_Params):
         "safety_penalty": NON_NEGATIVE,
         "r_edge_factor": POSITIVE,
         "tie_eps": NON_NEGATIVE,
+        "safetygraph_goal": OneOf(("escape", "paper")),
     }
 
 

@@ -54,6 +54,9 @@ class WorldView:
     zones: Mapping[str, np.ndarray] = field(default_factory=dict)
     #: guards still in play (a guard taken down is inactive)
     guard_active: np.ndarray | None = None
+    #: index of the world's current decision tick (world.decision_interval when decisions
+    #: are gated, else the AI tick): a policy that re-plans once per tick compares it
+    decision_tick: int = 0
 
     @property
     def n_guards(self) -> int:
