@@ -188,6 +188,10 @@ class PlayerParams(_Params):
     safety_penalty: float = 4.0
     r_edge_factor: float = 2.5  # partition step horizon of SafetyGraph
     tie_eps: float = 1e-9
+    #: SafetyGraph's goal rule: "escape" (ours: the farthest node kept ``safety_margin`` safe,
+    #: re-planned at every decision) or "paper" (the paper's text only: the safest node, A*
+    #: with a Euclidean heuristic, margin 0, re-planned once per decision tick); ai/players.py
+    safetygraph_goal: str = "escape"
 
     bounds = {
         "maxmin_depth": Range(1, 6, integer=True),
@@ -198,6 +202,7 @@ class PlayerParams(_Params):
         "safety_penalty": NON_NEGATIVE,
         "r_edge_factor": POSITIVE,
         "tie_eps": NON_NEGATIVE,
+        "safetygraph_goal": OneOf(("escape", "paper")),
     }
 
 

@@ -7,6 +7,9 @@ cached: MaxMin's move sequences per start node, SafetyGraph's edge list.
 
 from __future__ import annotations
 
+import heapq
+import itertools
+import math
 import weakref
 from collections.abc import Mapping
 from typing import Any
@@ -159,6 +162,12 @@ class SafetyGraphPlayer(PlayerPolicy):
     safety_margin − S(head)))``; among equally cheap routes the one with the safest first
     node is taken. The answer is the farthest node along that path within the move
     horizon (one neighbour on the grid).
+
+    ``safetygraph_goal = "paper"`` is the paper's description and nothing more (docs/ai.md
+    quotes it): the goal is the reachable node of greatest S (:meth:`paper_goal`; no
+    far-side rule, margin 0), the path an A* search with the straight-line heuristic and
+    edge costs ``length × (1 + safety_penalty × max(0, −S(head)))`` (:meth:`astar`), planned
+    once per decision tick (``WorldView.decision_tick``) and followed between ticks.
     """
 
     policy = "safetygraph"
@@ -176,6 +185,9 @@ class SafetyGraphPlayer(PlayerPolicy):
         self.horizon = move_horizon(graph, self.config.r_edge_factor)
         self.last_safety: np.ndarray | None = None
         self.last_goal: int | None = None
+        #: "paper": the A* path of the current decision tick and that tick's index
+        self.plan: list[int] = []
+        self.plan_tick: int | None = None
 
     def safety(self, player: int, guards: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """(S, T_g) per node for the player at ``player`` and guards at ``guards``."""
@@ -189,6 +201,8 @@ class SafetyGraphPlayer(PlayerPolicy):
         guards = active_guard_nodes(view)
         if len(guards) == 0:
             return node
+        if self.config.safetygraph_goal == "paper":
+            return self._decide_paper(view, node, guards)
         safety, guard_time = self.safety(node, guards)
         goal = self.choose_goal(node, safety, guard_time)
         self.last_safety, self.last_goal = safety, goal
@@ -239,6 +253,72 @@ class SafetyGraphPlayer(PlayerPolicy):
         while path[-1] != goal:
             path.append(int(successor[path[-1]]))
         return path
+
+    # -------------------------------------------------------- the paper's text only
+
+    def _decide_paper(self, view: WorldView, node: int, guards: np.ndarray) -> int:
+        """``safetygraph_goal = "paper"``: at the first decision of a decision tick
+        (``view.decision_tick``) plan with :meth:`paper_goal` and :meth:`astar`; until the
+        next tick, step along that plan from wherever the player stands on it (re-plan
+        early only when it is off the plan, e.g. a stuck body re-routed)."""
+        if view.decision_tick != self.plan_tick or node not in self.plan:
+            safety, _ = self.safety(node, guards)
+            goal = self.paper_goal(node, safety)
+            self.last_safety, self.last_goal = safety, goal
+            self.plan, self.plan_tick = self.astar(node, goal, safety), view.decision_tick
+        path = self.plan[self.plan.index(node):]
+        return self._step_along(path)
+
+    def paper_goal(self, node: int, safety: np.ndarray) -> int:
+        """The reachable node of greatest safety S (ties within ``tie_eps``: the generator).
+
+        With equal speeds S(v) ≤ S(player) for every v (triangle inequality), so the ties
+        are the player's own node and the nodes it shields from its nearest guard (those
+        whose shortest path from that guard runs through the player); a cornered player has
+        only its own node and stands still.
+        """
+        reachable = self.graph.reachable_from(node) & ~np.isnan(safety)
+        score = np.where(reachable, safety, -np.inf)
+        goals = np.flatnonzero(score >= score.max() - self.config.tie_eps)  # inf: unguarded
+        return int(goals[0] if len(goals) == 1 else goals[self.rng.integers(len(goals))])
+
+    def astar(self, node: int, goal: int, safety: np.ndarray) -> list[int]:
+        """A* from ``node`` to ``goal``: entering v costs ``length × (1 + safety_penalty ×
+        max(0, −S(v)))`` (margin 0), heuristic the straight-line distance to the goal
+        (admissible: no edge is shorter than the straight line between its nodes). Ties in
+        the open list go first in, first out, so the result is a function of the inputs."""
+        if node == goal:
+            return [node]
+        deficit = np.where(np.isfinite(safety), -safety, 0.0)  # unguarded / unreachable: none
+        penalty = 1.0 + self.config.safety_penalty * np.maximum(0.0, deficit)
+        positions = self.graph.positions
+        heuristic = np.linalg.norm(positions - positions[goal], axis=1)
+        indptr, indices, lengths = self._indptr, self._indices, self._lengths
+        cost = {node: 0.0}
+        parent: dict[int, int] = {}
+        counter = itertools.count()
+        open_list = [(float(heuristic[node]), next(counter), node)]
+        closed: set[int] = set()
+        while open_list:
+            _, _, u = heapq.heappop(open_list)
+            if u == goal:
+                path = [u]
+                while path[-1] != node:
+                    path.append(parent[path[-1]])
+                return path[::-1]
+            if u in closed:
+                continue
+            closed.add(u)
+            base = cost[u]
+            for e in range(indptr[u], indptr[u + 1]):
+                v = int(indices[e])
+                if v in closed:
+                    continue
+                g = base + float(lengths[e] * penalty[v])
+                if g < cost.get(v, math.inf):
+                    cost[v], parent[v] = g, u
+                    heapq.heappush(open_list, (g + float(heuristic[v]), next(counter), v))
+        return [node]  # the goal is unreachable (paper_goal only picks reachable nodes)
 
     def _step_along(self, path: list[int]) -> int:
         """The farthest node on ``path`` within the move horizon (at least one step)."""

@@ -57,6 +57,9 @@ class WorldView:
     #: per guard, the nodes it sees at this AI tick (filled only at AI ticks and only for a
     #: mode whose :meth:`GuardAI.wants_guard_sight` is true); None: not computed
     guard_sight: tuple[np.ndarray, ...] | None = None
+    #: index of the world's current decision tick (world.decision_interval when decisions
+    #: are gated, else the AI tick): a policy that re-plans once per tick compares it
+    decision_tick: int = 0
 
     @property
     def n_guards(self) -> int:

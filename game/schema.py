@@ -47,13 +47,19 @@ __all__ = [
 SPAWN_RULES = ("random", "level")
 """``world.spawns``: guard start nodes drawn per seed, or the level's spawn points."""
 
-RESPAWN_RULES = ("farthest", "random")
+RESPAWN_RULES = ("farthest", "random", "stay")
 """``world.respawn``: where the fixed-time scenario puts a captured player (game.spawns):
-the start rule's farthest hidden node, or a hidden node drawn uniformly."""
+the start rule's farthest hidden node, a hidden node drawn uniformly, or where it stands
+(``stay``: HP restored, no teleport; the paper's trial runs "regardless of the player's
+health status")."""
 
 SEED = Range(0, 2**63 - 1, integer=True)
 """A trial's ``seed`` and a preset's ``root_seed``: whole numbers that fit the store's
 64-bit integer column (``numpy.random.SeedSequence`` refuses negative ones)."""
+
+#: seconds between decision ticks, 0 = on arrival; longer than 10 s is no decision rule
+#: of the paper's (1 s) and would leave agents standing most of a 60 s trial
+DECISION_INTERVAL = Range(0.0, 10.0)
 
 #: SPEC §6: the physics step is at most 1/20 s (faster bodies would tunnel through walls)
 _PHYSICS_STEP = Range(0.0, 0.05, low_open=True)
@@ -66,6 +72,8 @@ WORLD: Mapping[str, Bound] = {
     "ai_tick": POSITIVE,
     # 0 = decide on arrival (SPEC §6); > 0 = the paper's grid decision tick (game.world)
     "grid_decision_interval": NON_NEGATIVE,
+    # both abstractions; > 0 wins over grid_decision_interval (game.world.decision_interval)
+    "decision_interval": DECISION_INTERVAL,
     "physics_step": _PHYSICS_STEP,
     "physics_step_interactive": _PHYSICS_STEP,
     "duration": POSITIVE,

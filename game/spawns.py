@@ -74,9 +74,14 @@ def hidden_node(graph: NodeGraph, guards: Sequence[Agent], senses: Senses, view_
 
 
 def respawn_node(rule: str, graph: NodeGraph, guards: Sequence[Agent], senses: Senses,
-                 view_range: float, rng: np.random.Generator) -> int:
+                 view_range: float, rng: np.random.Generator, *, here: int | None = None) -> int:
     """Where a player captured in the fixed-time scenario comes back (``world.respawn``):
-    ``"farthest"`` is :func:`start_node` (SPEC §7), ``"random"`` :func:`hidden_node`."""
+    ``"farthest"`` is :func:`start_node` (SPEC §7), ``"random"`` :func:`hidden_node`,
+    ``"stay"`` the node ``here`` it was captured on (no draw from ``rng``)."""
+    if rule == "stay":
+        if here is None:
+            raise ValueError("world.respawn = 'stay' needs the node the player stands on")
+        return here
     if rule == "farthest":
         return start_node(graph, guards, senses, view_range, rng)
     if rule == "random":

@@ -6,7 +6,7 @@ AI tick); player actions in :mod:`game.actions`, metrics in :mod:`game.metrics`,
 from __future__ import annotations
 
 import math
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from typing import Any
 
 import numpy as np
@@ -33,7 +33,8 @@ from .zones import ZoneMap
 
 SCENARIOS = ("capture", "fixed")
 Generators = tuple[np.random.Generator, np.random.Generator, np.random.Generator]
-__all__ = ["Agent", "RANGE_EPS", "Refused", "SCENARIOS", "World", "default_rngs"]
+__all__ = ["Agent", "RANGE_EPS", "Refused", "SCENARIOS", "World", "decision_interval",
+           "default_rngs"]
 
 
 class World(PlayerActions):
@@ -63,10 +64,13 @@ class World(PlayerActions):
         s = config.section(f"scenario.{scenario}")
         self.dt = float(w["physics_step_interactive"] if interactive else w["physics_step"])
         self.steps_per_tick = max(1, round(float(w["ai_tick"]) / self.dt))
-        # The paper's grid agents move one cell per decision tick: > 0 gates decisions on the
-        # grid to every this many steps (an arrived agent waits on its cell centre); 0: none.
-        interval = float(w["grid_decision_interval"]) if self.graph.mesh is None else 0.0
+        # The paper's decision tick: > 0 gates decisions to every this many steps (an arrived
+        # agent waits on its target until then, a walking one walks on); 0: on arrival.
+        interval = decision_interval(w, grid=self.graph.mesh is None)
         self.steps_per_decision = max(1, round(interval / self.dt)) if interval > 0 else 1
+        # the clock of policies that re-plan once per tick (SafetyGraph "paper"): the decision
+        # tick when decisions are gated, else the AI tick (WorldView.decision_tick)
+        self.steps_per_plan = self.steps_per_decision if interval > 0 else self.steps_per_tick
         self.respawn = str(w["respawn"])
         self.total_steps = round(float(w["duration"]) / self.dt)
         self.end_on_capture = bool(s["end_on_capture"])
@@ -188,6 +192,7 @@ class World(PlayerActions):
             player_node=self.player.node, player_pos=np.array(self.player.pos),
             seen_by=self.seen_by, sighting=self.sighting, events=tuple(self.tick_events),
             zones=self.zones, guard_active=np.array([g.active for g in self.guards], dtype=bool),
+            decision_tick=self.step_index // self.steps_per_plan,
         )
 
     def step(self) -> None:
@@ -284,11 +289,14 @@ class World(PlayerActions):
         if self.end_on_capture:
             self.done = True
             return
-        # Fixed-time scenario: respawn at a fresh start position with full HP.
+        # Fixed-time scenario: full HP again, at a fresh start position (world.respawn) or,
+        # with "stay", where the player stands, still walking its plan. Guards still in range
+        # hurt it from the next step on: the next capture is a second depletion of full HP.
         self.health.heal()
         node = respawn_node(self.respawn, self.graph, self.guards, self.senses,
-                            self.view_range, self.spawn_rng)
-        self.place_player(node)
+                            self.view_range, self.spawn_rng, here=self.player.node)
+        if self.respawn != "stay":
+            self.place_player(node)
         self.events.append(Event("respawn", node, self.t))
 
     def _ai_tick(self) -> None:
@@ -331,6 +339,16 @@ class World(PlayerActions):
     def trace_record(self) -> dict[str, Any]:
         """One trace line (:func:`game.trace.trace_record`)."""
         return trace.trace_record(self)
+
+
+def decision_interval(world: Mapping[str, Any], *, grid: bool) -> float:
+    """Seconds between decision ticks under the ``[world]`` section ``world``, 0 = decide on
+    arrival: ``decision_interval`` when > 0 (both abstractions), else on the grid
+    ``grid_decision_interval`` (the older, grid-only key), else 0."""
+    interval = float(world["decision_interval"])
+    if interval > 0:
+        return interval
+    return float(world["grid_decision_interval"]) if grid else 0.0
 
 
 def default_rngs(seed: int) -> Generators:
