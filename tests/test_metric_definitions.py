@@ -238,3 +238,16 @@ def test_an_older_store_without_the_definition_columns_reports_and_resumes(tmp_p
     assert all(t["coverage_visited"] == t["coverage"] for t in trials
                if t["coverage_visited"] is not None)
     assert all(not math.isnan(t["coverage"]) for t in trials)
+
+
+def test_the_report_names_the_coverage_and_distance_definition_in_use(tmp_path: Path) -> None:
+    from headless.readme import metric_rules
+    from headless.tables import write_table
+
+    assert metric_rules({}) == {"coverage": "visited", "backtracks": "targets", "distance": "path"}
+    rules = metric_rules({"set": {"metrics.coverage": "per_guard", "metrics.distance": "euclidean"}})
+    assert rules == {"coverage": "per_guard", "backtracks": "targets", "distance": "euclidean"}
+    write_table([], tmp_path, 0)
+    assert "CoverageRate is a true fraction in [0, 1]" in (tmp_path / "table.md").read_text()
+    write_table([], tmp_path, 0, "per_guard")
+    assert "can exceed 1" in (tmp_path / "table.md").read_text()
