@@ -5,10 +5,11 @@ world's one vision rule (:meth:`game.senses.Senses.perceives`: within the view r
 by the node's zone, inside the cone, a clear line), i.e. a player standing there would
 have been seen. Per guard and tick only the nodes within the view range are looked at
 (the grid's cell window or a k-d tree of the partition's centroids), the range and cone
-tests are vectorised over them, and only the unseen ones that pass get a ray (the one
-pymunk query the player's sight uses), so a trial casts a ray per newly seen node plus one
-per occluded node of each cone and tick (about 1,700 rays, 10-20 ms, in a 60-s trial on
-the bundled levels).
+tests are vectorised over them, and only the unseen ones that pass need a line of sight.
+Most of those are occluded, tick after tick: the wall that last blocked a node's ray is
+kept, and a line it still crosses plainly (no end of either segment within rounding of the
+other) is blocked without a ray; every other line is the pymunk query the player's sight
+uses (:meth:`game.senses.Senses.clear_line`).
 """
 
 from __future__ import annotations
@@ -18,14 +19,18 @@ import weakref
 from collections.abc import Iterable
 
 import numpy as np
+import pymunk
 from scipy.spatial import cKDTree
 
 from navmesh.graph import NodeGraph
 
-from .agents import Agent
+from .agents import WALL_QUERY, Agent
 from .senses import RANGE_EPS, Senses
 
 __all__ = ["ViewCover", "nodes_within"]
+
+#: a side test within this share of |ray|·|wall| of zero is left to pymunk (rounding)
+_TOLERANCE = 1e-9
 
 #: per graph (graphs are cached and shared by trials): the k-d tree of a partition's nodes
 _TREES: weakref.WeakKeyDictionary[NodeGraph, cKDTree] = weakref.WeakKeyDictionary()
@@ -37,8 +42,10 @@ def nodes_within(graph: NodeGraph, x: float, y: float, radius: float) -> np.ndar
     if graph.cell_node is not None:
         size = graph.cell_size
         rows, cols = graph.cell_node.shape
-        r0, r1 = max(0, math.floor((y - radius) / size)), min(rows - 1, math.floor((y + radius) / size))
-        c0, c1 = max(0, math.floor((x - radius) / size)), min(cols - 1, math.floor((x + radius) / size))
+        r0 = max(0, math.floor((y - radius) / size))
+        r1 = min(rows - 1, math.floor((y + radius) / size))
+        c0 = max(0, math.floor((x - radius) / size))
+        c1 = min(cols - 1, math.floor((x + radius) / size))
         if r0 > r1 or c0 > c1:
             return np.zeros(0, dtype=np.int64)
         window = graph.cell_node[r0:r1 + 1, c0:c1 + 1].ravel()
@@ -62,30 +69,70 @@ class ViewCover:
         self.limit = self.reach + RANGE_EPS
         self.bound = float(self.reach.max()) if len(self.reach) else 0.0
         self.seen = np.zeros(graph.n, dtype=bool)
+        #: per node: the wall (index into ``_walls``) that blocked its last ray, or -1
+        self.blocker = np.full(graph.n, -1, dtype=np.int32)
+        walls = [shape for shape in senses.space.shapes if isinstance(shape, pymunk.Segment)]
+        self._wall_index: dict[pymunk.Shape, int] = {shape: i for i, shape in enumerate(walls)}
+        ends = [(*shape.a, *shape.b) for shape in walls]
+        self._walls = np.array(ends, dtype=np.float64).reshape(-1, 4)
 
     def observe(self, guards: Iterable[Agent]) -> None:
-        """Mark every node an active guard perceives now (one AI tick)."""
-        positions, seen, clear = self.graph.positions, self.seen, self.senses.clear_line
-        cos_half = self.senses.cos_half_fov
-        for guard in guards:
-            if not guard.active:
-                continue
-            x, y = guard.pos
-            near = nodes_within(self.graph, x, y, self.bound)
-            near = near[~seen[near]]
-            if not len(near):
-                continue
-            dx, dy = positions[near, 0] - x, positions[near, 1] - y
-            d2 = dx * dx + dy * dy
-            d = np.sqrt(d2)
-            # Senses.perceives, vectorised: range (with the zone), then the cone
-            keep = (d2 <= self.limit[near] ** 2) & (
-                (d <= 1e-9) | (dx * math.cos(guard.heading) + dy * math.sin(guard.heading)
-                               >= cos_half * d))
-            near = near[keep]
-            for k, point in zip(near.tolist(), positions[near].tolist()):
-                if clear((x, y), (point[0], point[1])):
-                    seen[k] = True
+        """Mark every node an active guard perceives now (one AI tick); the guards' nodes
+        in range are tested together, one array per test."""
+        active = [g for g in guards if g.active]
+        parts = [nodes_within(self.graph, g.pos[0], g.pos[1], self.bound) for g in active]
+        if not parts:
+            return
+        near = np.concatenate(parts)
+        owner = np.repeat(np.arange(len(active)), [len(p) for p in parts])
+        unseen = ~self.seen[near]
+        near, owner = near[unseen], owner[unseen]
+        if not len(near):
+            return
+        pos = np.array([g.pos for g in active], dtype=np.float64)
+        # math's cos and sin, as Senses.perceives takes them (numpy's may differ in a bit)
+        cos = np.array([math.cos(g.heading) for g in active])[owner]
+        sin = np.array([math.sin(g.heading) for g in active])[owner]
+        gx, gy = pos[owner, 0], pos[owner, 1]
+        points = self.graph.positions[near]
+        dx, dy = points[:, 0] - gx, points[:, 1] - gy
+        d2 = dx * dx + dy * dy
+        d = np.sqrt(d2)
+        # Senses.perceives, vectorised: range (with the zone), then the cone
+        keep = (d2 <= self.limit[near] ** 2) & (
+            (d <= 1e-9) | (dx * cos + dy * sin >= self.senses.cos_half_fov * d))
+        keep[keep] = ~self._still_blocked(gx[keep], gy[keep], points[keep], near[keep])
+        query, seen, blocker = self.senses.space.segment_query_first, self.seen, self.blocker
+        for k, (px, py), (x, y) in zip(near[keep].tolist(), points[keep].tolist(),
+                                       pos[owner[keep]].tolist()):
+            hit = query((x, y), (px, py), 0.0, WALL_QUERY)
+            if hit is None:
+                seen[k] = True
+            else:
+                blocker[k] = self._wall_index.get(hit.shape, -1)
+
+    def _still_blocked(self, x: np.ndarray, y: np.ndarray, points: np.ndarray,
+                       nodes: np.ndarray) -> np.ndarray:
+        """Per line from (x, y) to a node's point: the wall that last blocked the node's ray
+        plainly crosses it — both ends of each segment strictly on either side of the
+        other, beyond rounding — so the ray would hit a wall too."""
+        wall = self.blocker[nodes]
+        out = np.zeros(len(nodes), dtype=bool)
+        known = np.flatnonzero(wall >= 0)
+        if not len(known):
+            return out
+        ax, ay, bx, by = self._walls[wall[known]].T
+        x, y = x[known], y[known]
+        px, py = points[known, 0], points[known, 1]
+        rx, ry, wx, wy = px - x, py - y, bx - ax, by - ay
+        s_o = wx * (y - ay) - wy * (x - ax)      # the ray's ends against the wall's line
+        s_p = wx * (py - ay) - wy * (px - ax)
+        s_a = rx * (ay - y) - ry * (ax - x)      # the wall's ends against the ray's line
+        s_b = rx * (by - y) - ry * (bx - x)
+        tol = _TOLERANCE * np.hypot(rx, ry) * np.hypot(wx, wy)
+        out[known] = ((s_o * s_p < 0) & (s_a * s_b < 0) & (np.minimum(
+            np.minimum(np.abs(s_o), np.abs(s_p)), np.minimum(np.abs(s_a), np.abs(s_b))) > tol))
+        return out
 
     def share(self) -> float:
         """The share of nodes seen so far (0 on an empty graph)."""

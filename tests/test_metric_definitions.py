@@ -58,7 +58,8 @@ def test_a_metrics_key_changes_what_is_measured_never_the_trace(abstraction: str
     assert trace.count("\n") >= 20
     for key, values in KEYS.items():
         for value in values:
-            spec = TrialSpec(**base, overrides=(("world.duration", 20.0), (f"metrics.{key}", value)))
+            overrides = (("world.duration", 20.0), (f"metrics.{key}", value))
+            spec = TrialSpec(**base, overrides=overrides)
             other_trace, other = _traced(spec)
             assert other_trace == trace, f"metrics.{key} = {value} changed the trace"
             # every definition column is the same; the keyed column is the one named
@@ -70,7 +71,8 @@ def test_a_metrics_key_changes_what_is_measured_never_the_trace(abstraction: str
 def test_seen_coverage_exceeds_visited_on_miami_grid_pf() -> None:
     seen = _sim("miami", "grid", "pf", "metrics.coverage=seen")
     visited = _sim("miami", "grid", "pf")
-    assert seen["coverage"] == seen["coverage_seen"] > visited["coverage"] == visited["coverage_visited"]
+    assert seen["coverage"] == seen["coverage_seen"] > visited["coverage"]
+    assert visited["coverage"] == visited["coverage_visited"]
     assert 0 < seen["coverage"] <= 1
 
 
@@ -97,7 +99,8 @@ def test_a_bad_metrics_value_is_one_line_and_exit_2() -> None:
     done = subprocess.run([sys.executable, "-m", "headless.cli", "sim", "maze", "--set",
                            "metrics.coverage=everything"], capture_output=True, text=True)
     assert done.returncode == 2 and done.stdout == ""
-    assert done.stderr.startswith("stealth: error: metrics.coverage") and done.stderr.count("\n") == 1
+    assert done.stderr.startswith("stealth: error: metrics.coverage")
+    assert done.stderr.count("\n") == 1
 
 
 # ---------------------------------------------------------------------- the counters
@@ -154,13 +157,17 @@ def _brute_seen(world: Any) -> np.ndarray:
 def test_seen_nodes_are_exactly_what_the_world_perceives(level: str, abstraction: str) -> None:
     world = make_world(TrialSpec(level=level, abstraction=abstraction, guards="pf",
                                  player="maxmin", scenario="fixed", seed=2))
-    for _ in range(3):  # three AI ticks, each checked on its own
+    union = np.zeros(world.graph.n, dtype=bool)
+    for _ in range(6):  # six AI ticks: the world's cover (its walls kept) and a fresh one
         for _ in range(world.steps_per_tick):
             world.step()
+        now = _brute_seen(world)
+        union |= now
         fresh = ViewCover(world.graph, world.senses, world.view_range * world.view_scale_at)
         fresh.observe(world.guards)
-        expected = _brute_seen(world)
-        assert expected.any() and np.array_equal(fresh.seen, expected)
+        assert now.any() and np.array_equal(fresh.seen, now)
+        assert world.m.view_cover is not None and np.array_equal(world.m.view_cover.seen, union)
+    assert (world.m.view_cover.blocker >= 0).any()  # occluded nodes were met and kept
 
 
 @pytest.mark.parametrize("level,abstraction", [("maze", "grid"), ("miami", "partition")])
@@ -231,3 +238,16 @@ def test_an_older_store_without_the_definition_columns_reports_and_resumes(tmp_p
     assert all(t["coverage_visited"] == t["coverage"] for t in trials
                if t["coverage_visited"] is not None)
     assert all(not math.isnan(t["coverage"]) for t in trials)
+
+
+def test_the_report_names_the_coverage_and_distance_definition_in_use(tmp_path: Path) -> None:
+    from headless.readme import metric_rules
+    from headless.tables import write_table
+
+    assert metric_rules({}) == {"coverage": "visited", "backtracks": "targets", "distance": "path"}
+    rules = metric_rules({"set": {"metrics.coverage": "per_guard", "metrics.distance": "euclidean"}})
+    assert rules == {"coverage": "per_guard", "backtracks": "targets", "distance": "euclidean"}
+    write_table([], tmp_path, 0)
+    assert "CoverageRate is a true fraction in [0, 1]" in (tmp_path / "table.md").read_text()
+    write_table([], tmp_path, 0, "per_guard")
+    assert "can exceed 1" in (tmp_path / "table.md").read_text()
