@@ -27,7 +27,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 if TYPE_CHECKING:
-    from .distance_worker import DistanceWorker
+    from .large.distance_worker import DistanceWorker
     from .world import World
 
 __all__ = ["AGGREGATES", "Counters", "Metric", "TableColumn", "register_metric",
