@@ -22,11 +22,11 @@ import numpy as np
 
 from navmesh.level import load_level
 
-from .mechanics import BOOTSTRAP, DRAW_DISTANCES, EXPECTED, MECHANICS, Row, run_job
-from .executors import check_workers, process_pool
-from .filenames import output_path
-from .progress import Progress
-from .stats import mean_or_nan, percentile_ci
+from .measures import BOOTSTRAP, DRAW_DISTANCES, EXPECTED, MECHANICS, Row, run_job
+from ..executors import check_workers, process_pool
+from ..outputs.filenames import output_path
+from ..progress import Progress
+from ..analysis.stats import mean_or_nan, percentile_ci
 
 
 # ---------------------------------------------------------------------------- statistics

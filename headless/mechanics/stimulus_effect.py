@@ -28,9 +28,9 @@ from game.trial import TrialSpec, run_trial
 from game.world import SCENARIOS
 from navmesh.level import load_level
 
-from .errors import UserError
-from .mechanics import Row
-from .mechanics_run import effects_table, refuse_arguments, run_jobs, summarise, write_results
+from ..errors import UserError
+from .measures import Row
+from .run import effects_table, refuse_arguments, run_jobs, summarise, write_results
 
 __all__ = ["check_measure", "measure_label", "plugin_measures", "run_plugin_job",
            "cmd_stimulus_effect"]

@@ -23,10 +23,10 @@ from pathlib import Path
 from typing import Any
 
 from .beside_paper import COLUMNS
-from .errors import UserError
+from ..errors import UserError
 from .markers import replace_marked
-from .objective import Cell, Target, aggregate, load_target
-from .store import ResultStore
+from ..tune.objective import Cell, Target, aggregate, load_target
+from ..store import ResultStore
 from .tables import ABSTRACTION_NAMES, GUARD_NAMES, PLAYER_NAMES
 
 __all__ = ["Compared", "compare", "distance", "held_out_markdown", "held_out_trials", "main",

@@ -23,14 +23,14 @@ from typing import Any
 
 from game.metrics import TableColumn, registered_metrics
 
-from .errors import UserError
+from ..errors import UserError
 from .expr import Expression
-from .tables import _Durations, metric_value, table_columns
+from ..analysis.tables import _Durations, metric_value, table_columns
 
 __all__ = ["ALIASES", "TARGETS_DIR", "Cell", "Target", "aggregate", "as_trials", "load_target",
            "lookup_for", "check_names"]
 
-TARGETS_DIR = Path(__file__).resolve().parent / "targets"
+TARGETS_DIR = Path(__file__).resolve().parent.parent / "targets"
 """Bundled target tables (``paper-table3.csv``)."""
 
 ALIASES = {"capture_rate": "captured"}

@@ -23,7 +23,7 @@ from ai import make_player_policy
 from game.config import Config
 from game.trial import player_params
 
-from .mechanics_world import BLIND, Measures, active_guard_nodes, make_world, run_until
+from .worlds import BLIND, Measures, active_guard_nodes, make_world, run_until
 HP = {"world.player_hp": 1.0e6}
 
 

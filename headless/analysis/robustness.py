@@ -29,11 +29,11 @@ from typing import Any
 
 import numpy as np
 
-from .errors import UserError
+from ..errors import UserError
 from .markers import replace_marked
 from .factor_report import numeric_factors
 from .stats import bootstrap_ci
-from .store import STORE_NAME, ResultStore
+from ..store import STORE_NAME, ResultStore
 from .tables import ABSTRACTION_NAMES, GUARD_NAMES, _Durations, label, metric_value, table_columns
 
 __all__ = ["CLAIMS", "Axes", "Claim", "Judgement", "Verdict", "axes_of", "draw", "judge",

@@ -22,7 +22,7 @@ import numpy as np
 
 from game.metrics import TableColumn
 
-from .filenames import output_path
+from ..outputs.filenames import output_path
 from .palette import guard_colour
 from .tables import ABSTRACTION_NAMES, GUARD_NAMES, GUARD_SHORT, PLAYER_NAMES, PLAYER_SHORT, label
 from .tables import table_columns

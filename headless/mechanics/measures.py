@@ -36,8 +36,8 @@ from ai.stimuli import footstep_rule
 from ai.view import Action, Event
 from game.world import World
 
-from .mechanics_ai import AI_EXPECTED, AI_MECHANICS
-from .mechanics_world import BLIND, Measures, WanderPlayer, active_guard_nodes, make_world, run_until
+from .beyond import AI_EXPECTED, AI_MECHANICS
+from .worlds import BLIND, Measures, WanderPlayer, active_guard_nodes, make_world, run_until
 
 BOOTSTRAP = 2000
 

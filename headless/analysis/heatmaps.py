@@ -25,7 +25,7 @@ import numpy as np
 
 from ai import GUARD_MODES
 
-from .filenames import output_path
+from ..outputs.filenames import output_path
 from .palette import guard_colour
 from .tables import ABSTRACTION_NAMES, GUARD_NAMES
 from .tables import label as display

@@ -12,7 +12,7 @@ from pathlib import Path
 
 from .paper import is_paper_design
 from .stats import BOOTSTRAP_RESAMPLES, BOOTSTRAP_SEED
-from .store import STORE_NAME
+from ..store import STORE_NAME
 from .tables import table_columns
 
 __all__ = ["readme"]

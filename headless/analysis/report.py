@@ -36,16 +36,16 @@ from pathlib import Path
 
 from ai.stimuli import load_stimulus
 
-from .errors import UserError
+from ..errors import UserError
 from .factor_report import write_factor_report
 from .figures import FORMATS, write_aggregate
 from .heatmaps import HeatSums, figure_count, write_heatmaps
 from .paper import is_paper_design, paper_table3
-from .progress import Progress
+from ..progress import Progress
 from .readme import readme
-from .session_report import write_session_report
+from ..sessions.report import write_session_report
 from .stats import BOOTSTRAP_RESAMPLES, BOOTSTRAP_SEED, Stat, bootstrap_ci, summarise
-from .store import IDENTITY, STORE_NAME, ResultStore
+from ..store import IDENTITY, STORE_NAME, ResultStore
 from .tables import metric_value, table_columns, table_rows, write_table, write_trials_csv
 
 __all__ = [

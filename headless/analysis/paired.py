@@ -19,7 +19,7 @@ from typing import Any
 import numpy as np
 
 from .stats import bootstrap_ci
-from .store import STORE_NAME, ResultStore
+from ..store import STORE_NAME, ResultStore
 
 __all__ = ["MEASURES", "paired_rows", "paired_table"]
 
