@@ -3,7 +3,7 @@
 ``python -m headless.beside_paper DIR [--literal DIR2]`` reads ``DIR/table.csv`` (and, with
 ``--literal``, the PF rows of a ``paper-pf-literal`` report) and prints, per abstraction, one
 table whose cells are "ours (paper)", the paper's values from
-:data:`headless.paper.PAPER_TABLE3`, followed by ``DIR/table.md``'s full tables. docs/results.md
+:data:`headless.analysis.paper.PAPER_TABLE3`, followed by ``DIR/table.md``'s full tables. docs/results.md
 holds its output between the markers ``<!-- beside-paper -->`` and ``<!-- /beside-paper -->``;
 ``--write FILE`` replaces that part of FILE in place.
 """

@@ -2,7 +2,7 @@
 
 ``python -m headless.held_out DIR --seeds-from K`` reads the trials of ``DIR/results.sqlite``
 whose seed is at least K (the seeds a ``stealth tune`` study did not train on), aggregates
-them as Table 3 and the tune objective do (:func:`headless.objective.aggregate`) and prints,
+them as Table 3 and the tune objective do (:func:`headless.tune.objective.aggregate`) and prints,
 per abstraction, a table whose cells are "ours (paper, error)" with ✓ where the error is
 within the objective's tolerance (±0.10 for CaptureRate, ±25 % otherwise), then the share of
 cells within tolerance per column and the capture-rate cells. ``--baseline DIR2`` adds the
@@ -102,7 +102,7 @@ def _share(rows: Sequence[Compared]) -> str:
 
 
 def distance(rows: Sequence[Compared]) -> float:
-    """The tune objective of these cells (:meth:`headless.objective.Target.distance`)."""
+    """The tune objective of these cells (:meth:`headless.tune.objective.Target.distance`)."""
     scaled = [r.scaled if math.isfinite(r.scaled) else 10.0 for r in rows]
     return sum(e * e for e in scaled) / len(scaled)
 

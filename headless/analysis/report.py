@@ -13,15 +13,15 @@ Everything is written into DIR next to ``results.sqlite``:
 * ``aggregate_{abstraction}.{png,svg}`` — the paper's "Aggregated performance" bar figure,
   with the paper's values overlaid when the design is the paper's;
 * ``factors.{md,csv}``, ``factors/*/table.md``, ``factor_*.png`` — only for a design with
-  factors (:mod:`headless.factor_report`);
+  factors (:mod:`headless.analysis.factor_report`);
 * ``sessions.md`` / ``sessions.csv`` — only for recorded play sessions
-  (:mod:`headless.session_report`);
+  (:mod:`headless.sessions.report`);
 * ``failed.csv`` — only when some trial failed;
 * ``README.md`` — what the files are and where our metrics differ from the paper's.
 
-This module orchestrates: statistics in :mod:`headless.stats`, Table 3 and ``trials.csv`` in
-:mod:`headless.tables`, heatmaps in :mod:`headless.heatmaps`, the aggregate figure in
-:mod:`headless.figures`, the README in :mod:`headless.readme`; the metrics themselves come
+This module orchestrates: statistics in :mod:`headless.analysis.stats`, Table 3 and ``trials.csv`` in
+:mod:`headless.analysis.tables`, heatmaps in :mod:`headless.analysis.heatmaps`, the aggregate figure in
+:mod:`headless.analysis.figures`, the README in :mod:`headless.analysis.readme`; the metrics themselves come
 from the registry :mod:`game.metrics`. matplotlib is imported lazily and drawn through
 ``Figure`` (no pyplot, no global backend switch), so reports work on headless machines.
 """

@@ -6,7 +6,7 @@ reads a store whose design crosses exactly two numeric factors (e.g. the
 factor cell, each claim of :data:`CLAIMS`. A claim is a set of comparisons "mode A above
 mode B" on one Table 3 measure; a comparison is the mean of the **paired** differences
 A − B over the trials of one identity (level, player policy, scenario, seed: the same
-spawns), with a 95 % percentile-bootstrap CI (:func:`headless.stats.bootstrap_ci`). A
+spawns), with a 95 % percentile-bootstrap CI (:func:`headless.analysis.stats.bootstrap_ci`). A
 comparison **holds** when its CI lies above 0, **fails** when it lies below 0 (the reverse
 is shown) and is **undecided** otherwise; a claim holds when all its comparisons hold,
 fails when any fails, and is undecided otherwise. No correction for the several

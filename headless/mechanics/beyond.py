@@ -1,7 +1,7 @@
 """Paired measurements of the guard mechanics beyond the paper (``stealth mechanics``).
 
 Each against its control on the same seed (docs/mechanics.md), PF guards, scenario
-``fixed``, as the paper's seven mechanics are measured in :mod:`headless.mechanics`:
+``fixed``, as the paper's seven mechanics are measured in :mod:`headless.mechanics.measures`:
 
 | mechanic | arm "on" | control | per-seed measure |
 |---|---|---|---|

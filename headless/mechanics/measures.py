@@ -21,7 +21,7 @@ never overrides the stimulus being measured. Scenario ``fixed`` speeds (× 1.0).
 
 Trials run in a process pool (``--workers``; 1 = in-process). Writes ``mechanics.md`` (the
 table), ``mechanics.csv`` (one row per measure) and ``mechanics_trials.csv`` (one row per
-seed and measure, both arms) — run by :mod:`headless.mechanics_run`; this module defines the mechanics.
+seed and measure, both arms) — run by :mod:`headless.mechanics.run`; this module defines the mechanics.
 """
 
 from __future__ import annotations

@@ -1,6 +1,6 @@
 """Running and summarising the mechanics experiment (``stealth mechanics``; docs/mechanics.md).
 
-The mechanic definitions (each one's paired measurement) are in :mod:`headless.mechanics`;
+The mechanic definitions (each one's paired measurement) are in :mod:`headless.mechanics.measures`;
 this module runs their jobs in a process pool, bootstraps the paired differences, and writes
 ``mechanics.md``, ``mechanics.csv`` and ``mechanics_trials.csv``.
 """
@@ -245,7 +245,7 @@ def refuse_arguments(args: argparse.Namespace) -> int | None:
 
 
 def cmd_mechanics(args: argparse.Namespace) -> int:
-    """``stealth mechanics`` (without ``--stimulus``, :mod:`headless.stimulus_effect`): run
+    """``stealth mechanics`` (without ``--stimulus``, :mod:`headless.mechanics.stimulus_effect`): run
     the paired experiment, write the files, print the table."""
     refused = refuse_arguments(args)
     if refused is not None:

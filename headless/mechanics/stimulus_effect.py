@@ -1,6 +1,6 @@
 """``stealth mechanics --stimulus FILE.py:NAME``: a user's mechanic against a paired control.
 
-Like the built-in mechanics (:mod:`headless.mechanics`), every seed runs twice — the same
+Like the built-in mechanics (:mod:`headless.mechanics.measures`), every seed runs twice — the same
 level, seed, guard spawns and generators (:func:`game.trial.trial_rngs` does not depend on
 the stimuli), with the plugin (arm ``on``) and without it (``control``) — and every
 measure is a mean with a 95 % bootstrap CI over seeds, the difference bootstrapped over

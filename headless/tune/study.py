@@ -4,9 +4,9 @@ SPEC.toml is a preset (the design; its ``seeds`` are replaced) plus
 
 * ``[search]`` — ``"key" = {low = , high = , log = false}`` (a float, or an int range when
   both bounds are whole numbers) or ``{choices = [...]}``, each a config key;
-* ``[objective]`` — ``maximize = "EXPR"`` or ``minimize = "EXPR"`` (:mod:`headless.expr`),
+* ``[objective]`` — ``maximize = "EXPR"`` or ``minimize = "EXPR"`` (:mod:`headless.tune.expr`),
   optional ``constraints = ["EXPR <= N", ...]``; or ``target = "FILE.csv"`` (minimise the
-  distance to a table, :mod:`headless.objective`);
+  distance to a table, :mod:`headless.tune.objective`);
 * ``seeds_train = N``, ``seeds_test = M``, optional ``sampler_seed`` (default 0).
 
 Each Optuna trial runs the design on seeds 0…N−1 with its parameters as ``[set]`` values,
