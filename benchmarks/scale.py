@@ -173,7 +173,7 @@ def _growth(jobs: list[Job], results: list[dict]) -> list[str]:
 
 def write_between_markers(path: Path, text: str) -> None:
     """Replace what stands between ``<!-- scale:begin -->`` and ``<!-- scale:end -->`` in ``path``."""
-    from headless.markers import replace_marked
+    from headless.analysis.markers import replace_marked
 
     begin, end = "<!-- scale:begin -->", "<!-- scale:end -->"
     if not replace_marked(path, begin, end, text + "\n"):

@@ -28,7 +28,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 if TYPE_CHECKING:
-    from .distance_worker import DistanceWorker
+    from .large.distance_worker import DistanceWorker
     from .view_cover import ViewCover
     from .world import World
 

@@ -41,7 +41,7 @@ from shapely.geometry.base import BaseGeometry
 from navmesh.graph import NodeGraph
 from navmesh.level import Level
 
-from .background import lowest_priority
+from .large.background import lowest_priority
 
 if TYPE_CHECKING:
     from .world import World

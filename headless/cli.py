@@ -222,7 +222,7 @@ def cmd_sim(args: argparse.Namespace) -> int:
     if args.trace:
         from navmesh.level import resolve_level_path
 
-        from .clobber import refuse_inputs
+        from .outputs.clobber import refuse_inputs
 
         plugins = [p.rpartition(":")[0] for p in args.stimulus if ":" in p]
         refuse_inputs("--trace", args.trace, [resolve_level_path(args.level), *plugins])
@@ -273,17 +273,17 @@ def _cmd_run(args: argparse.Namespace) -> int:
 
 
 def _cmd_report(args: argparse.Namespace) -> int:
-    from .report import cmd_report
+    from .analysis.report import cmd_report
 
     return cmd_report(args)
 
 
 def _cmd_mechanics(args: argparse.Namespace) -> int:
     if args.stimulus:
-        from .stimulus_effect import cmd_stimulus_effect
+        from .mechanics.stimulus_effect import cmd_stimulus_effect
 
         return cmd_stimulus_effect(args)
-    from .mechanics_run import cmd_mechanics
+    from .mechanics.run import cmd_mechanics
 
     return cmd_mechanics(args)
 
@@ -296,7 +296,7 @@ def _cmd_play(args: argparse.Namespace) -> int:
         args.set = [f"{k}={v}" for k, v in read_config_file(args.config).items()] + args.set
     if args.record is None:
         return cmd_play(args)
-    from .sessions import SessionStore
+    from .sessions.record import SessionStore
 
     sink = SessionStore(args.record, args.set)
     code = cmd_play(args, on_session=sink)
@@ -309,7 +309,7 @@ def _cmd_replay(args: argparse.Namespace) -> int:
 
     if args.trial is not None:
         from .reproduce import stored_spec, stored_trial
-        from .sessions import session_trace
+        from .sessions.record import session_trace
 
         if stored_trial(args.trace, args.trial)["player"] == "human":  # a played session:
             args.trace = str(session_trace(args.trace, args.trial))  # its recorded trace
@@ -319,7 +319,7 @@ def _cmd_replay(args: argparse.Namespace) -> int:
 
 
 def _cmd_tune(args: argparse.Namespace) -> int:
-    from .tune import cmd_tune
+    from .tune.study import cmd_tune
 
     return cmd_tune(args)
 

@@ -30,7 +30,7 @@ from typing import IO, Any
 from game.config_file import read_config_file
 from game.trial import TrialSpec
 
-from .dirlock import DirectoryLock
+from .outputs.dirlock import DirectoryLock
 from .errors import SweepError
 from .estimate import MEASURED_DURATION, duration_text, estimate_seconds
 from .executors import (
@@ -42,7 +42,7 @@ from .executors import (
     shutdown,
     terminate,
 )
-from .filenames import output_path
+from .outputs.filenames import output_path
 from .growth import design_change, design_trials, grown_design
 from .presets import Preset, load_preset
 from .progress import Progress

@@ -21,7 +21,7 @@ from scipy.sparse.csgraph import dijkstra
 from ai.fields import CompositeField, FieldMatrices
 from ai.params import PFParams
 from ai.prefetch import Prefetch
-from game.distance_worker import DistanceWorker
+from game.large.distance_worker import DistanceWorker
 from game.front.layers import StaticLayers
 from game.front.render import init_pygame
 from game.scene import FieldLayer, SceneBuilder, StaticScene
@@ -198,7 +198,7 @@ def test_the_game_over_screen_does_not_wait_for_the_worker() -> None:
 
 def test_without_room_for_the_worker_the_searches_run_here(monkeypatch) -> None:  # type: ignore[no-untyped-def]
     """No space for the graph's file (a full disk): no worker, the same distances."""
-    import game.distance_worker as module
+    import game.large.distance_worker as module
 
     def full_disk(*args, **kwargs):  # type: ignore[no-untyped-def]
         raise OSError(28, "No space left on device")

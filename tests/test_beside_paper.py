@@ -5,7 +5,7 @@ from __future__ import annotations
 import csv
 from pathlib import Path
 
-from headless.beside_paper import COLUMNS, main
+from headless.analysis.beside_paper import COLUMNS, main
 
 
 def _report(directory: Path, capture_rate: float) -> Path:

@@ -295,7 +295,7 @@ def test_a_bad_value_is_a_one_line_config_error() -> None:
 
 
 def test_stealth_mechanics_measures_each_new_rule_against_a_control() -> None:
-    from headless.mechanics import EXPECTED, MECHANICS
+    from headless.mechanics.measures import EXPECTED, MECHANICS
 
     assert {"perception", "alert", "radio", "roles"} <= set(MECHANICS)
     for name in ("perception", "alert", "radio", "roles"):

@@ -171,7 +171,7 @@ def test_mechanics_workers_die_with_their_parent(tmp_path: Path, sig: int) -> No
 
 def test_a_forked_child_does_not_keep_the_lock(tmp_path: Path) -> None:
     """The lock belongs to the process that took it: a fork's copy of it is dropped."""
-    from headless.dirlock import DirectoryLock
+    from headless.outputs.dirlock import DirectoryLock
 
     lock = DirectoryLock(tmp_path)
     read, write = os.pipe()

@@ -15,7 +15,7 @@ import pytest
 
 from headless.cli import main
 from headless.presets import load_preset
-from headless.report import write_report
+from headless.analysis.report import write_report
 from headless.sweep import run_sweep
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -67,7 +67,7 @@ def test_a_report_of_hostile_level_names_stays_inside_and_keeps_every_level(tmp_
 
 @pytest.mark.parametrize("name", HOSTILE + ["con", "x" * 300, "\ud800", "a\nb", "\u202egnp.exe"])
 def test_every_name_is_a_safe_part_inside_the_directory(tmp_path: Path, name: str) -> None:
-    from headless.filenames import output_path, safe_part
+    from headless.outputs.filenames import output_path, safe_part
 
     part = safe_part(name)
     assert re.fullmatch(r"[a-z0-9.-]+", part) and not part.startswith((".", "-")), part
@@ -78,7 +78,7 @@ def test_every_name_is_a_safe_part_inside_the_directory(tmp_path: Path, name: st
 
 
 def test_names_whose_slugs_collide_get_distinct_files() -> None:
-    from headless.filenames import output_path, safe_part
+    from headless.outputs.filenames import output_path, safe_part
 
     names = ["a/b", "a-b", "A-B", "a_b", "a?b", "a b", "a--b"]
     parts = {safe_part(n) for n in names}

@@ -15,9 +15,9 @@ os.environ.setdefault("SDL_VIDEODRIVER", "dummy")  # replay --trial, before pyga
 from game.trial import trial_rngs  # noqa: E402
 from headless.cli import main
 from headless.errors import UserError
-from headless.expr import parse_constraint, parse_expression
+from headless.tune.expr import parse_constraint, parse_expression
 from headless.presets import load_preset
-from headless.report import write_report
+from headless.analysis.report import write_report
 from headless.store import ResultStore
 from headless.sweep import run_sweep
 

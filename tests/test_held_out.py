@@ -7,8 +7,8 @@ from pathlib import Path
 
 import pytest
 
-from headless.held_out import compare, distance, held_out_trials, main
-from headless.objective import aggregate, load_target
+from headless.analysis.held_out import compare, distance, held_out_trials, main
+from headless.tune.objective import aggregate, load_target
 from headless.presets import load_preset
 from headless.sweep import run_sweep
 

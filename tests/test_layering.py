@@ -2,10 +2,11 @@
 
 * ``navmesh`` imports nothing of ``ai``, ``game``, ``headless``;
 * ``ai`` imports only ``navmesh`` (of ours);
-* ``game`` outside ``game/front`` never imports pygame, ``headless`` or ``game.front`` at
-  module level; inside a function only ``game/match.py`` (rendering the environments) may import ``game.front`` lazily
-  (rendering on request), and nothing of ``game`` core imports pygame or headless anywhere;
-* ``game/front`` imports nothing of ``headless``.
+* ``game`` core (outside ``game/front`` and ``game/env``) never imports pygame, ``headless``,
+  ``game.front`` or ``game.env``, at any depth;
+* ``game/front`` imports nothing of ``headless`` or ``game.env``;
+* ``game/env`` (the environments, which render through the front end) imports nothing of
+  ``headless`` and never pygame itself.
 """
 
 from __future__ import annotations
@@ -70,25 +71,34 @@ def test_ai_imports_only_navmesh() -> None:
     assert _violations("ai", {"ai", "navmesh"}) == []
 
 
-def test_game_core_never_imports_pygame_headless_or_the_front_end() -> None:
+def _under(module: str, package: str) -> bool:
+    return module == package or module.startswith(package + ".")
+
+
+def test_game_core_never_imports_pygame_headless_the_front_end_or_the_environments() -> None:
     bad = []
     for path in _files("game"):
         rel = path.relative_to(ROOT)
-        if rel.parts[1] == "front":
+        if rel.parts[1] in ("front", "env"):
             continue
-        for module, top in _imports(path):
-            if _root(module) in ("pygame", "headless"):
+        for module, _ in _imports(path):
+            if _root(module) in ("pygame", "headless") or _under(module, "game.front") or (
+                    _under(module, "game.env")):
                 bad.append(f"{rel} imports {module}")
-            elif module == "game.front" or module.startswith("game.front."):
-                if top or rel != Path("game/match.py"):
-                    bad.append(f"{rel} imports {module}" + (" at module level" if top else ""))
     assert bad == []
 
 
-def test_game_front_imports_nothing_of_headless() -> None:
+def test_game_front_imports_nothing_of_headless_or_the_environments() -> None:
     bad = [f"{path.relative_to(ROOT)} imports {module}"
            for path in _files("game/front") for module, _ in _imports(path)
-           if _root(module) == "headless"]
+           if _root(module) == "headless" or _under(module, "game.env")]
+    assert bad == []
+
+
+def test_the_environments_import_nothing_of_headless_nor_pygame() -> None:
+    bad = [f"{path.relative_to(ROOT)} imports {module}"
+           for path in _files("game/env") for module, _ in _imports(path)
+           if _root(module) in ("headless", "pygame")]
     assert bad == []
 
 

@@ -12,8 +12,8 @@ import pytest
 
 from game.metrics import Metric, metric_names, register_metric, unregister_metric
 from game.trial import TrialSpec
-from headless.figures import aggregate_figure, layout
-from headless.report import table_columns, table_rows, write_report
+from headless.analysis.figures import aggregate_figure, layout
+from headless.analysis.report import table_columns, table_rows, write_report
 from headless.store import ResultStore
 from headless.sweep import load_preset, run_sweep
 

@@ -6,7 +6,7 @@ from pathlib import Path
 
 import pytest
 
-from headless.paired import main, paired_rows, paired_table
+from headless.analysis.paired import main, paired_rows, paired_table
 from headless.presets import load_preset
 from headless.sweep import run_sweep
 

@@ -29,7 +29,7 @@ from game.trial import TrialSpec, make_world, run_trial
 from headless.cli import main
 from headless.errors import PresetError
 from headless.presets import load_preset
-from headless.report import write_report
+from headless.analysis.report import write_report
 from headless.sweep import run_sweep
 from navmesh.errors import LevelError
 from navmesh.level import load_level
@@ -216,7 +216,7 @@ def test_mechanics_measures_the_plugin_against_a_paired_control(tmp_path: Path, 
 
 
 def test_a_default_measure_has_no_intended_direction(tmp_path: Path, capsys) -> None:
-    from headless.stimulus_effect import plugin_measures
+    from headless.mechanics.stimulus_effect import plugin_measures
 
     bell = f"{ROOT / 'examples' / 'alarm_bell.py'}:AlarmBell"
     measure, expected = plugin_measures(bell)
@@ -229,8 +229,8 @@ def test_a_default_measure_has_no_intended_direction(tmp_path: Path, capsys) -> 
 
 
 def test_plugin_jobs_do_not_depend_on_the_worker_count() -> None:
-    from headless.mechanics_run import run_jobs
-    from headless.stimulus_effect import run_plugin_job
+    from headless.mechanics.run import run_jobs
+    from headless.mechanics.stimulus_effect import run_plugin_job
 
     jobs = [(PLUGIN, str(LEVEL), "grid", s) for s in range(2)]
     inline, _ = run_jobs(run_plugin_job, jobs, 1, progress=False)

@@ -13,7 +13,7 @@ import pytest
 
 from game.trial import TrialSpec
 from headless.cli import main
-from headless.report import (
+from headless.analysis.report import (
     BOOTSTRAP_RESAMPLES,
     BOOTSTRAP_SEED,
     table_columns,
@@ -280,9 +280,9 @@ def test_report_shows_progress_on_stderr(tmp_path: Path, capsys: pytest.CaptureF
 def test_a_mode_keeps_its_colour_whatever_the_report_holds() -> None:
     from matplotlib.colors import to_hex
 
-    from headless.figures import aggregate_figure
-    from headless.palette import guard_colour
-    from headless.stats import Stat
+    from headless.analysis.figures import aggregate_figure
+    from headless.analysis.palette import guard_colour
+    from headless.analysis.stats import Stat
 
     def rows(modes: list[str]) -> list[dict[str, Any]]:
         stat = Stat(4, 1.0, 0.1, 0.9, 1.1)
@@ -300,7 +300,7 @@ def test_a_mode_keeps_its_colour_whatever_the_report_holds() -> None:
 
 
 def _panels(values: dict[str, np.ndarray]) -> Any:
-    from headless.heatmaps import Panel, heatmap_panels
+    from headless.analysis.heatmaps import Panel, heatmap_panels
 
     level = load_level("maze")
     graph = graph_for(level, "grid")
@@ -325,7 +325,7 @@ def test_heatmap_panels_share_one_scale_log_when_counts_span_decades() -> None:
 def test_no_events_are_drawn_as_such() -> None:
     from matplotlib.colors import to_hex
 
-    from headless.heatmaps import NO_EVENTS
+    from headless.analysis.heatmaps import NO_EVENTS
 
     fig = _panels({"pf": np.array([0.0]), "random": np.array([2.0, 0.0])})
     empty, some = (ax for ax in fig.axes if ax.images)
@@ -342,9 +342,9 @@ def test_no_events_are_drawn_as_such() -> None:
 
 
 def test_the_paper_values_are_overlaid_only_on_the_papers_design() -> None:
-    from headless.figures import aggregate_figure
-    from headless.paper import is_paper_design, paper_table3
-    from headless.stats import Stat
+    from headless.analysis.figures import aggregate_figure
+    from headless.analysis.paper import is_paper_design, paper_table3
+    from headless.analysis.stats import Stat
 
     stat = Stat(4, 0.5, 0.1, 0.4, 0.6)
     rows = [{"abstraction": "grid", "guards": m, "player": p,

@@ -10,9 +10,9 @@ import pytest
 
 from headless.errors import UserError
 from headless.presets import load_preset
-from headless.robustness import END, SECTION, START, judge, main, write_between_markers
+from headless.analysis.robustness import END, SECTION, START, judge, main, write_between_markers
 from headless.store import STORE_NAME, ResultStore
-from headless.tune import load_tune_spec
+from headless.tune.study import load_tune_spec
 
 GUARDS = ("cheat", "pf", "staleness", "fsm", "random")
 #: capture rank (Cheat > PF > Staleness > FSM > RandomWalk, as the paper)

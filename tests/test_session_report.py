@@ -10,9 +10,9 @@ import pytest
 from game.config import Config
 from game.record import HUMAN, Recording
 from game.trial import TrialSpec, make_world
-from headless.report import write_report
-from headless.session_report import write_session_report
-from headless.sessions import SessionStore
+from headless.analysis.report import write_report
+from headless.sessions.report import write_session_report
+from headless.sessions.record import SessionStore
 
 SHORT = ("world.duration=4",)
 

@@ -18,7 +18,7 @@ import pytest
 from game.trial import TrialSpec
 from headless import executors
 from headless.cli import main
-from headless.report import write_report
+from headless.analysis.report import write_report
 from headless.store import ResultStore
 from headless.presets import load_preset
 from headless.progress import Progress

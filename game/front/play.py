@@ -23,7 +23,7 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from typing import Any
 
-from game.distance_worker import DistanceWorker
+from game.large.distance_worker import DistanceWorker
 from game.front.camera import Camera
 from game.front.effects import NoiseRings, draw_rain
 from game.front.layers import COMPOSE_STRIPES

@@ -1,10 +1,10 @@
 """What a ``stealth tune`` trial scores: metric expressions or the distance to a target table.
 
 The rows of one evaluation (``run_trial`` rows of the design at one point of the search
-space) are aggregated as Table 3 aggregates them (:func:`headless.tables.metric_value`:
+space) are aggregated as Table 3 aggregates them (:func:`headless.analysis.tables.metric_value`:
 ``captured`` as 1/0, censored times as the full duration), then read by the objective:
 
-* an :class:`~headless.expr.Expression` over metric names (``capture_rate`` is ``captured``),
+* an :class:`~headless.tune.expr.Expression` over metric names (``capture_rate`` is ``captured``),
   each the mean over the trials of its scenario, narrowed by selectors (``pf.captures``);
 * or a **target table** (``abstraction, guards, player`` and one column per metric, as
   ``headless/targets/paper-table3.csv``, the paper's Table 3): the mean over its cells of
@@ -23,14 +23,14 @@ from typing import Any
 
 from game.metrics import TableColumn, registered_metrics
 
-from .errors import UserError
+from ..errors import UserError
 from .expr import Expression
-from .tables import _Durations, metric_value, table_columns
+from ..analysis.tables import _Durations, metric_value, table_columns
 
 __all__ = ["ALIASES", "TARGETS_DIR", "Cell", "Target", "aggregate", "as_trials", "load_target",
            "lookup_for", "check_names"]
 
-TARGETS_DIR = Path(__file__).resolve().parent / "targets"
+TARGETS_DIR = Path(__file__).resolve().parent.parent / "targets"
 """Bundled target tables (``paper-table3.csv``)."""
 
 ALIASES = {"capture_rate": "captured"}

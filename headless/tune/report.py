@@ -19,7 +19,7 @@ from typing import TYPE_CHECKING, Any
 from game.config_file import write_config_file
 
 if TYPE_CHECKING:
-    from .tune import TuneSpec
+    from .study import TuneSpec
 
 __all__ = ["write_study_outputs"]
 

@@ -1,7 +1,7 @@
 """The worlds of the mechanics experiment (``stealth mechanics``): PF worlds of the
 ``fixed`` scenario whose generators depend on (level, seed, tag) only, a player that
-wanders, and stepping a world to a time; shared by :mod:`headless.mechanics` (the paper's
-mechanics) and :mod:`headless.mechanics_ai` (those beyond it)."""
+wanders, and stepping a world to a time; shared by :mod:`headless.mechanics.measures` (the paper's
+mechanics) and :mod:`headless.mechanics.beyond` (those beyond it)."""
 
 from __future__ import annotations
 

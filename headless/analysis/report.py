@@ -13,15 +13,15 @@ Everything is written into DIR next to ``results.sqlite``:
 * ``aggregate_{abstraction}.{png,svg}`` — the paper's "Aggregated performance" bar figure,
   with the paper's values overlaid when the design is the paper's;
 * ``factors.{md,csv}``, ``factors/*/table.md``, ``factor_*.png`` — only for a design with
-  factors (:mod:`headless.factor_report`);
+  factors (:mod:`headless.analysis.factor_report`);
 * ``sessions.md`` / ``sessions.csv`` — only for recorded play sessions
-  (:mod:`headless.session_report`);
+  (:mod:`headless.sessions.report`);
 * ``failed.csv`` — only when some trial failed;
 * ``README.md`` — what the files are and where our metrics differ from the paper's.
 
-This module orchestrates: statistics in :mod:`headless.stats`, Table 3 and ``trials.csv`` in
-:mod:`headless.tables`, heatmaps in :mod:`headless.heatmaps`, the aggregate figure in
-:mod:`headless.figures`, the README in :mod:`headless.readme`; the metrics themselves come
+This module orchestrates: statistics in :mod:`headless.analysis.stats`, Table 3 and ``trials.csv`` in
+:mod:`headless.analysis.tables`, heatmaps in :mod:`headless.analysis.heatmaps`, the aggregate figure in
+:mod:`headless.analysis.figures`, the README in :mod:`headless.analysis.readme`; the metrics themselves come
 from the registry :mod:`game.metrics`. matplotlib is imported lazily and drawn through
 ``Figure`` (no pyplot, no global backend switch), so reports work on headless machines.
 """
@@ -36,16 +36,16 @@ from pathlib import Path
 
 from ai.stimuli import load_stimulus
 
-from .errors import UserError
+from ..errors import UserError
 from .factor_report import write_factor_report
 from .figures import FORMATS, write_aggregate
 from .heatmaps import HeatSums, figure_count, write_heatmaps
 from .paper import is_paper_design, paper_table3
-from .progress import Progress
+from ..progress import Progress
 from .readme import metric_rules, readme
-from .session_report import write_session_report
+from ..sessions.report import write_session_report
 from .stats import BOOTSTRAP_RESAMPLES, BOOTSTRAP_SEED, Stat, bootstrap_ci, summarise
-from .store import IDENTITY, STORE_NAME, ResultStore
+from ..store import IDENTITY, STORE_NAME, ResultStore
 from .tables import metric_value, table_columns, table_rows, write_table, write_trials_csv
 
 __all__ = [

@@ -1,6 +1,6 @@
 """``stealth mechanics --stimulus FILE.py:NAME``: a user's mechanic against a paired control.
 
-Like the built-in mechanics (:mod:`headless.mechanics`), every seed runs twice — the same
+Like the built-in mechanics (:mod:`headless.mechanics.measures`), every seed runs twice — the same
 level, seed, guard spawns and generators (:func:`game.trial.trial_rngs` does not depend on
 the stimuli), with the plugin (arm ``on``) and without it (``control``) — and every
 measure is a mean with a 95 % bootstrap CI over seeds, the difference bootstrapped over
@@ -28,9 +28,9 @@ from game.trial import TrialSpec, run_trial
 from game.world import SCENARIOS
 from navmesh.level import load_level
 
-from .errors import UserError
-from .mechanics import Row
-from .mechanics_run import effects_table, refuse_arguments, run_jobs, summarise, write_results
+from ..errors import UserError
+from .measures import Row
+from .run import effects_table, refuse_arguments, run_jobs, summarise, write_results
 
 __all__ = ["check_measure", "measure_label", "plugin_measures", "run_plugin_job",
            "cmd_stimulus_effect"]

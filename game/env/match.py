@@ -21,10 +21,10 @@ from ai.view import PlayerPolicy, WorldView
 from navmesh.graph import NodeGraph, graph_for
 from navmesh.level import cached_level
 
-from .config import Config
+from ..config import Config
 from .observations import OBS_BOUND, Observer
-from .trial import TrialSpec, make_world
-from .world import World
+from ..trial import TrialSpec, make_world
+from ..world import World
 
 __all__ = ["ExternalGuards", "ExternalPlayer", "GRID_ACTIONS", "Match", "PARTITION_ACTIONS",
            "REWARDS"]

@@ -1,7 +1,7 @@
 """Paired measurements of the guard mechanics beyond the paper (``stealth mechanics``).
 
 Each against its control on the same seed (docs/mechanics.md), PF guards, scenario
-``fixed``, as the paper's seven mechanics are measured in :mod:`headless.mechanics`:
+``fixed``, as the paper's seven mechanics are measured in :mod:`headless.mechanics.measures`:
 
 | mechanic | arm "on" | control | per-seed measure |
 |---|---|---|---|
@@ -23,7 +23,7 @@ from ai import make_player_policy
 from game.config import Config
 from game.trial import player_params
 
-from .mechanics_world import BLIND, Measures, active_guard_nodes, make_world, run_until
+from .worlds import BLIND, Measures, active_guard_nodes, make_world, run_until
 HP = {"world.player_hp": 1.0e6}
 
 

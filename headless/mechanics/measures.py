@@ -21,7 +21,7 @@ never overrides the stimulus being measured. Scenario ``fixed`` speeds (× 1.0).
 
 Trials run in a process pool (``--workers``; 1 = in-process). Writes ``mechanics.md`` (the
 table), ``mechanics.csv`` (one row per measure) and ``mechanics_trials.csv`` (one row per
-seed and measure, both arms) — run by :mod:`headless.mechanics_run`; this module defines the mechanics.
+seed and measure, both arms) — run by :mod:`headless.mechanics.run`; this module defines the mechanics.
 """
 
 from __future__ import annotations
@@ -36,8 +36,8 @@ from ai.stimuli import footstep_rule
 from ai.view import Action, Event
 from game.world import World
 
-from .mechanics_ai import AI_EXPECTED, AI_MECHANICS
-from .mechanics_world import BLIND, Measures, WanderPlayer, active_guard_nodes, make_world, run_until
+from .beyond import AI_EXPECTED, AI_MECHANICS
+from .worlds import BLIND, Measures, WanderPlayer, active_guard_nodes, make_world, run_until
 
 BOOTSTRAP = 2000
 

@@ -1,11 +1,11 @@
 """The aggregate figure: ``aggregate_{abstraction}.png``, the paper's "Aggregated performance".
 
-One bar panel per Table 3 column (:func:`headless.tables.table_columns`), bars per guard
+One bar panel per Table 3 column (:func:`headless.analysis.tables.table_columns`), bars per guard
 mode × player policy with 95 % bootstrap CI whiskers. The grid is derived from the columns:
 one band of rows per scenario (capture first, as in the paper), at most
 :data:`MAX_COLUMNS` panels a row, and the legend in the first free cells (or a row of its
 own) — so a registered metric adds a panel instead of being dropped. Each mode has its
-colour of :mod:`headless.palette`; when the design is the paper's (:mod:`headless.paper`)
+colour of :mod:`headless.analysis.palette`; when the design is the paper's (:mod:`headless.analysis.paper`)
 the paper's published value of each bar is drawn on it as a black diamond. Written as PNG
 and SVG.
 """
@@ -22,7 +22,7 @@ import numpy as np
 
 from game.metrics import TableColumn
 
-from .filenames import output_path
+from ..outputs.filenames import output_path
 from .palette import guard_colour
 from .tables import ABSTRACTION_NAMES, GUARD_NAMES, GUARD_SHORT, PLAYER_NAMES, PLAYER_SHORT, label
 from .tables import table_columns
@@ -84,7 +84,7 @@ def layout(columns: Sequence[TableColumn]) -> Layout:
 
 def aggregate_figure(rows: Sequence[Mapping[str, Any]], abstraction: str,
                      paper: Paper | None = None) -> Any:
-    """The matplotlib ``Figure`` of one abstraction's rows of :func:`headless.tables.table_rows`.
+    """The matplotlib ``Figure`` of one abstraction's rows of :func:`headless.analysis.tables.table_rows`.
 
     Its first axes are the metric panels in :func:`table_columns` order, the last one the
     legend. With ``paper``, each bar whose cell and metric the paper reports gets the

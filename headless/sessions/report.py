@@ -31,7 +31,7 @@ from typing import Any
 from game.metrics import TableColumn
 from game.record import HUMAN, QUESTIONS
 
-from .tables import PLAYER_NAMES, csv_value, label, metric_value, table_columns
+from ..analysis.tables import PLAYER_NAMES, csv_value, label, metric_value, table_columns
 
 __all__ = ["SESSION_METRICS", "session_rows", "write_session_report"]
 

@@ -20,7 +20,7 @@ from navmesh.graph import NodeGraph
 from navmesh.level import Level
 
 if TYPE_CHECKING:
-    from .world import World
+    from ..world import World
 
 __all__ = ["GUARD_CHANNELS", "GUARD_FEATURES", "OBS_BOUND", "OTHER_GUARD", "Observer",
            "PLAYER_AS_SEEN", "PLAYER_CHANNELS", "PLAYER_FEATURES", "active_guards"]

@@ -14,7 +14,7 @@ import os
 from pathlib import Path
 from typing import IO
 
-from .errors import SweepError
+from ..errors import SweepError
 
 __all__ = ["LOCK_NAME", "DirectoryLock"]
 

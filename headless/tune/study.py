@@ -4,9 +4,9 @@ SPEC.toml is a preset (the design; its ``seeds`` are replaced) plus
 
 * ``[search]`` — ``"key" = {low = , high = , log = false}`` (a float, or an int range when
   both bounds are whole numbers) or ``{choices = [...]}``, each a config key;
-* ``[objective]`` — ``maximize = "EXPR"`` or ``minimize = "EXPR"`` (:mod:`headless.expr`),
+* ``[objective]`` — ``maximize = "EXPR"`` or ``minimize = "EXPR"`` (:mod:`headless.tune.expr`),
   optional ``constraints = ["EXPR <= N", ...]``; or ``target = "FILE.csv"`` (minimise the
-  distance to a table, :mod:`headless.objective`);
+  distance to a table, :mod:`headless.tune.objective`);
 * ``seeds_train = N``, ``seeds_test = M``, optional ``sampler_seed`` (default 0).
 
 Each Optuna trial runs the design on seeds 0…N−1 with its parameters as ``[set]`` values,
@@ -39,17 +39,17 @@ from game.errors import ConfigError
 from game.trial import TrialSpec
 from navmesh.files import FileRefused, read_regular
 
-from .errors import SweepError, UserError
-from .executors import (InlineExecutor, connect_dask, process_pool, run_batch, shutdown,
+from ..errors import SweepError, UserError
+from ..executors import (InlineExecutor, connect_dask, process_pool, run_batch, shutdown,
                         terminate)
 from .expr import Expression, parse_constraint, parse_expression
 from .objective import Target, as_trials, check_names, load_target, lookup_for
-from .presets import MAX_PRESET_BYTES, Preset, check_setting, parse_preset
+from ..presets import MAX_PRESET_BYTES, Preset, check_setting, parse_preset
 
 __all__ = ["Param", "TuneSpec", "cmd_tune", "load_tune_spec", "run_study"]
 
 STUDY_NAME = "stealth-tune"
-STUDIES_DIR = Path(__file__).resolve().parent / "studies"
+STUDIES_DIR = Path(__file__).resolve().parent.parent / "studies"
 """Bundled tune specs (``stealth tune paper-calibrate``)."""
 _TUNE_KEYS = ("search", "objective", "seeds_train", "seeds_test", "sampler_seed")
 
@@ -325,7 +325,7 @@ def run_study(spec: TuneSpec, out: Path, trials: int, *, workers: int | None = N
             shutdown(executor)
         if client is not None:
             client.close()
-    from .tune_report import write_study_outputs
+    from .report import write_study_outputs
 
     write_study_outputs(spec, study, best, test, out)
     return out

@@ -20,8 +20,8 @@ from game.config import Config
 from game.record import policy_row
 from game.trial import TrialSpec
 
-from .errors import UserError
-from .store import STORE_NAME, ResultStore
+from ..errors import UserError
+from ..store import STORE_NAME, ResultStore
 
 __all__ = ["COMPARE", "SessionStore", "session_trace"]
 

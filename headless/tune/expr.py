@@ -25,7 +25,7 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
-from .errors import UserError
+from ..errors import UserError
 
 __all__ = ["Expression", "Lookup", "parse_constraint", "parse_expression"]
 

@@ -1,7 +1,7 @@
 """Summary statistics of the reports: means, sample std and percentile-bootstrap CIs.
 
-Shared by Table 3 (:mod:`headless.tables`) and ``stealth mechanics``
-(:mod:`headless.mechanics`). A bootstrap draws its resample indices as one
+Shared by Table 3 (:mod:`headless.analysis.tables`) and ``stealth mechanics``
+(:mod:`headless.mechanics.measures`). A bootstrap draws its resample indices as one
 ``integers(0, n, size=(resamples, n))`` matrix from the generator it is given;
 :func:`bootstrap_ci` seeds that generator from a label, so a table cell's interval depends
 only on its own values and label.

@@ -15,7 +15,7 @@ from game.metrics import registered_metrics
 
 from .paper import is_paper_design
 from .stats import BOOTSTRAP_RESAMPLES, BOOTSTRAP_SEED
-from .store import STORE_NAME
+from ..store import STORE_NAME
 from .tables import table_columns
 
 __all__ = ["metric_rules", "readme"]

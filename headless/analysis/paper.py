@@ -22,7 +22,7 @@ from typing import Any
 
 __all__ = ["PAPER_LEVELS", "PAPER_TABLE3", "is_paper_design", "paper_table3"]
 
-PAPER_TABLE3 = Path(__file__).resolve().parent / "targets" / "paper-table3.csv"
+PAPER_TABLE3 = Path(__file__).resolve().parent.parent / "targets" / "paper-table3.csv"
 """The paper's Table 3 as CSV: one row per abstraction, guard mode and player policy."""
 
 PAPER_LEVELS = frozenset({"arkham", "dishonored", "maze", "miami", "tlou"})

@@ -2,12 +2,12 @@
 
 ``heatmaps/{level}_{abstraction}_{mode}_{visit,attack}.csv``: the per-node counts summed
 over every trial of that level, abstraction and guard mode (names made safe by
-:func:`headless.filenames.output_path`).
+:func:`headless.outputs.filenames.output_path`).
 ``heatmaps/{level}_{abstraction}_{visit,attack}.{png,svg}``: the paper's side-by-side
 figure, one panel per guard mode on **one colour scale** (log when the counts span
 :data:`LOG_DECADES` decades or more), nodes without any event drawn in their own colour
 (and a mode without any event marked "no events"), each panel framed in its mode's colour
-(:mod:`headless.palette`). matplotlib is imported lazily and drawn through ``Figure`` (no
+(:mod:`headless.analysis.palette`). matplotlib is imported lazily and drawn through ``Figure`` (no
 pyplot), so this works on headless machines.
 """
 
@@ -25,7 +25,7 @@ import numpy as np
 
 from ai import GUARD_MODES
 
-from .filenames import output_path
+from ..outputs.filenames import output_path
 from .palette import guard_colour
 from .tables import ABSTRACTION_NAMES, GUARD_NAMES
 from .tables import label as display

@@ -16,7 +16,7 @@ from typing import Any
 from game.metrics import TableColumn, metric_names, registered_metrics
 
 from .stats import Stat, summarise
-from .store import IDENTITY
+from ..store import IDENTITY
 
 __all__ = ["ABSTRACTION_NAMES", "GUARD_NAMES", "GUARD_SHORT", "PLAYER_NAMES", "PLAYER_SHORT",
            "label", "metric_value", "table_columns", "table_rows", "write_table",

@@ -17,9 +17,9 @@ generators of trial seed ``s`` (:func:`game.trial.trial_rngs`), so guard spawns,
 and the player's start are those of every headless trial with that level, abstraction and
 seed; the following seedless resets play seeds ``s + 1``, ``s + 2``, ...
 
-Only rendering imports pygame (``game.front``), inside :meth:`game.match.Match.render`.
-Observations: :mod:`game.observations`; the match (world, controllers, rewards):
-:mod:`game.match`.
+Only rendering imports pygame (``game.front``), inside :meth:`game.env.match.Match.render`.
+Observations: :mod:`game.env.observations`; the match (world, controllers, rewards):
+:mod:`game.env.match`.
 """
 
 from __future__ import annotations

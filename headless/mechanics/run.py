@@ -1,6 +1,6 @@
 """Running and summarising the mechanics experiment (``stealth mechanics``; docs/mechanics.md).
 
-The mechanic definitions (each one's paired measurement) are in :mod:`headless.mechanics`;
+The mechanic definitions (each one's paired measurement) are in :mod:`headless.mechanics.measures`;
 this module runs their jobs in a process pool, bootstraps the paired differences, and writes
 ``mechanics.md``, ``mechanics.csv`` and ``mechanics_trials.csv``.
 """
@@ -22,11 +22,11 @@ import numpy as np
 
 from navmesh.level import load_level
 
-from .mechanics import BOOTSTRAP, DRAW_DISTANCES, EXPECTED, MECHANICS, Row, run_job
-from .executors import check_workers, process_pool
-from .filenames import output_path
-from .progress import Progress
-from .stats import mean_or_nan, percentile_ci
+from .measures import BOOTSTRAP, DRAW_DISTANCES, EXPECTED, MECHANICS, Row, run_job
+from ..executors import check_workers, process_pool
+from ..outputs.filenames import output_path
+from ..progress import Progress
+from ..analysis.stats import mean_or_nan, percentile_ci
 
 
 # ---------------------------------------------------------------------------- statistics
@@ -245,7 +245,7 @@ def refuse_arguments(args: argparse.Namespace) -> int | None:
 
 
 def cmd_mechanics(args: argparse.Namespace) -> int:
-    """``stealth mechanics`` (without ``--stimulus``, :mod:`headless.stimulus_effect`): run
+    """``stealth mechanics`` (without ``--stimulus``, :mod:`headless.mechanics.stimulus_effect`): run
     the paired experiment, write the files, print the table."""
     refused = refuse_arguments(args)
     if refused is not None:

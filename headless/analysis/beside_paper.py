@@ -1,0 +1,98 @@
+"""Our Table 3 beside the paper's: the Markdown tables of docs/results.md, made from reports.
+
+``python -m headless.beside_paper DIR [--literal DIR2]`` reads ``DIR/table.csv`` (and, with
+``--literal``, the PF rows of a ``paper-pf-literal`` report) and prints, per abstraction, one
+table whose cells are "ours (paper)", the paper's values from
+:data:`headless.analysis.paper.PAPER_TABLE3`, followed by ``DIR/table.md``'s full tables. docs/results.md
+holds its output between the markers ``<!-- beside-paper -->`` and ``<!-- /beside-paper -->``;
+``--write FILE`` replaces that part of FILE in place.
+"""
+
+from __future__ import annotations
+
+import argparse
+import csv
+import sys
+from collections.abc import Mapping, Sequence
+from pathlib import Path
+
+from .markers import replace_marked
+from .paper import paper_table3
+
+__all__ = ["COLUMNS", "beside_paper", "main"]
+
+#: (Table 3 column, the paper table's metric) in the paper's order
+COLUMNS: tuple[tuple[str, str], ...] = (
+    ("CaptureRate", "captured"), ("CaptureTime", "capture_time"),
+    ("CapturesInTime", "captures"), ("CoverageRate", "coverage"),
+    ("AvgGuardPlayerDist", "avg_guard_player_dist"), ("FirstDetectTime", "first_detect_time"),
+    ("BacktrackCount", "backtracks"),
+)
+_BEGIN, _END = "<!-- beside-paper -->", "<!-- /beside-paper -->"
+_TITLES = {"grid": "Grid", "partition": "Partition"}
+
+
+def _rows(path: Path) -> list[dict[str, str]]:
+    with path.open(newline="", encoding="utf-8") as handle:
+        return list(csv.DictReader(handle))
+
+
+def _table(abstraction: str, ours: Sequence[Mapping[str, str]],
+           literal: Sequence[Mapping[str, str]]) -> list[str]:
+    paper = paper_table3()
+    head = "| GuardMode | PlayerMode | " + " | ".join(c for c, _ in COLUMNS) + " |"
+    lines = [f"**{_TITLES.get(abstraction, abstraction)}** — each cell: ours (paper)", "",
+             head, "|---|---|" + "---:|" * len(COLUMNS)]
+    for row in ours:
+        if row["abstraction"] != abstraction:
+            continue
+        key = (abstraction, row["guards"], row["player"])
+        cells = []
+        for column, metric in COLUMNS:
+            value = f"{float(row[f'{column}_mean']):.2f}"
+            if key in paper and metric in paper[key]:
+                value += f" ({paper[key][metric]:.2f})"
+            cells.append(value)
+        lines.append(f"| {row['GuardMode']} | {row['PlayerMode']} | " + " | ".join(cells) + " |")
+        for lit in literal:
+            if (lit["abstraction"], lit["guards"], lit["player"]) == key and key[1] == "pf":
+                values = " | ".join(f"{float(lit[f'{c}_mean']):.2f}" for c, _ in COLUMNS)
+                lines.append(f"| PF, paper-literal | {lit['PlayerMode']} | {values} |")
+    return lines
+
+
+def beside_paper(directory: Path, literal: Path | None = None) -> str:
+    """The Markdown of docs/results.md's tables for the report in ``directory``."""
+    ours = _rows(directory / "table.csv")
+    lit = _rows(literal / "table.csv") if literal is not None else []
+    out: list[str] = []
+    for abstraction in dict.fromkeys(r["abstraction"] for r in ours):
+        out += _table(abstraction, ours, lit) + [""]
+    full = (directory / "table.md").read_text(encoding="utf-8")
+    body = full.split("\n## ", 1)[1] if "\n## " in full else full
+    out += ["Our full table, with sample standard deviations and 95 % bootstrap confidence "
+            "intervals of", "the mean:", "", "## " + body.strip()]
+    return "\n".join(out) + "\n"
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(prog="python -m headless.beside_paper",
+                                     description=__doc__.split("\n\n")[0])
+    parser.add_argument("dir", type=Path, help="a report of the paper preset")
+    parser.add_argument("--literal", type=Path, default=None,
+                        help="a report of the paper-pf-literal preset (its PF rows are added)")
+    parser.add_argument("--write", type=Path, default=None,
+                        help="replace the marked part of this Markdown file instead of printing")
+    args = parser.parse_args(argv)
+    text = beside_paper(args.dir, args.literal)
+    if args.write is None:
+        sys.stdout.write(text)
+        return 0
+    if not replace_marked(args.write, _BEGIN, _END, text):
+        print(f"stealth: error: {args.write}: no {_BEGIN} ... {_END} markers", file=sys.stderr)
+        return 2
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

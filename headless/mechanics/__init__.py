@@ -1,0 +1,1 @@
+"""``stealth mechanics``: each mechanic measured against its paired control."""

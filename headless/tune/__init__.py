@@ -1,0 +1,1 @@
+"""``stealth tune``: an Optuna study of config values against an objective."""
