@@ -2,7 +2,7 @@
 
 Level names such as ``../../x``, ``a/b``, ``NUL``, a NUL character or non-ASCII text used to
 be pasted into the report's heatmap names: ``..`` wrote outside the results directory, ``/``
-and NUL crashed the report. Every writer now asks :func:`headless.filenames.output_path`.
+and NUL crashed the report. Every writer now asks :func:`headless.outputs.filenames.output_path`.
 """
 
 from __future__ import annotations

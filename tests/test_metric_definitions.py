@@ -20,7 +20,7 @@ from game.config import Config
 from game.metrics import RECENT_ENTRIES, Counters
 from game.trial import TrialSpec, make_world, run_trial
 from game.view_cover import ViewCover, nodes_within
-from headless.report import write_report
+from headless.analysis.report import write_report
 from headless.store import STORE_NAME, ResultStore
 from headless.presets import load_preset
 from headless.sweep import run_sweep
@@ -241,8 +241,8 @@ def test_an_older_store_without_the_definition_columns_reports_and_resumes(tmp_p
 
 
 def test_the_report_names_the_coverage_and_distance_definition_in_use(tmp_path: Path) -> None:
-    from headless.readme import metric_rules
-    from headless.tables import write_table
+    from headless.analysis.readme import metric_rules
+    from headless.analysis.tables import write_table
 
     assert metric_rules({}) == {"coverage": "visited", "backtracks": "targets", "distance": "path"}
     rules = metric_rules({"set": {"metrics.coverage": "per_guard", "metrics.distance": "euclidean"}})

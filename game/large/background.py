@@ -2,7 +2,7 @@
 
 The game on a large level computes its field overlay on a thread
 (:class:`game.scene.SceneBuilder`) and the distance metric's searches in a process
-(:mod:`game.distance_worker`). On a machine of two cores they would otherwise take a core
+(:mod:`game.large.distance_worker`). On a machine of two cores they would otherwise take a core
 from the frame loop or from the display server just when a frame is due; at nice 19 they
 use what is left. Their results are the same either way, only later.
 """

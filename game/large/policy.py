@@ -3,7 +3,7 @@
 On a graph that keeps dense distances (every bundled level) everything is computed in the
 frame. On one that searches per source (:mod:`navmesh.distances`), the front end computes
 the whole-field overlay on a background thread, composes new field values over a few frames
-and hands the distance metric's searches to a worker process (:mod:`game.distance_worker`).
+and hands the distance metric's searches to a worker process (:mod:`game.large.distance_worker`).
 None of it changes a value, only when it is computed.
 """
 
@@ -45,5 +45,5 @@ class SizePolicy:
 
     @property
     def distance_worker(self) -> bool:
-        """Run the distance metric's searches in a worker process (:mod:`game.distance_worker`)."""
+        """Run the distance metric's searches in a worker process (:mod:`game.large.distance_worker`)."""
         return self.large
