@@ -229,7 +229,8 @@ class StealthEnv(gymnasium.Env):
         self.match = Match(level, abstraction, scenario, guards, overrides, **options)
         self.render_mode = self.match.render_mode
         self.observation_space = self.match.obs_space(False)
-        self.action_space = spaces.Discrete(self.match.n_actions)
+        self._actions = spaces.Discrete(self.match.n_actions)
+        self.action_space = self._actions
 
     def reset(self, *, seed: int | None = None, options: dict | None = None
               ) -> tuple[np.ndarray, dict[str, Any]]:
@@ -243,7 +244,7 @@ class StealthEnv(gymnasium.Env):
 
     def step(self, action: Any) -> tuple[np.ndarray, float, bool, bool, dict[str, Any]]:
         """One player move; an action outside ``action_space`` is a ValueError naming it."""
-        action = check_action(self.action_space, action, "the player")
+        action = check_action(self._actions, action, "the player")
         reward, terminated, truncated = self.match.step(action)
         obs = self.match.observe_player()
         if self.render_mode == "human":

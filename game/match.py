@@ -37,7 +37,7 @@ PARTITION_ACTIONS = ("stay", "north", "northeast", "east", "southeast",
 #: Default reward terms (see docs/api.md, "Rewards"): per second survived, per HP lost, per
 #: capture, per second seen by a guard, and per second near a guard (the weight at distance
 #: 0, falling linearly to 0 at the guards' view range, along the level's paths).
-REWARDS = {"survival": 0.1, "hp": 1.0, "capture": 10.0, "seen": 0.5, "proximity": 1.0}
+REWARDS = {"survival": 0.1, "hp": 1.0, "capture": 10.0, "seen": 1.0, "proximity": 3.0}
 
 
 def _direction_table(graph: NodeGraph) -> np.ndarray:
@@ -133,7 +133,7 @@ class Match:
     """
 
     def __init__(self, level: str, abstraction: str, scenario: str, guard_mode: str | None,
-                 overrides: Mapping[str, Any], obs_radius: int = 4,
+                 overrides: Mapping[str, Any], obs_radius: int = 2,
                  rewards: Mapping[str, float] | None = None,
                  render_mode: str | None = None,
                  render_size: tuple[int, int] | None = None) -> None:

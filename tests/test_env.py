@@ -301,3 +301,16 @@ def test_vector_entry_point_steps_several_worlds() -> None:
     for _ in range(10):
         obs, rewards, *_ = venv.step(np.array([1, 2]))
     assert obs.shape[0] == 2 and rewards.shape == (2,)
+
+
+def test_supersuit_vectorises_the_parallel_env_as_it_is() -> None:
+    """docs/api.md: SuperSuit's PettingZoo → vector env wrappers need one observation size."""
+    supersuit = pytest.importorskip("supersuit")  # the `test` extra installs it
+    env = parallel_env("maze", world__guards=2, world__duration=3.0)
+    venv = supersuit.concat_vec_envs_v1(supersuit.pettingzoo_env_to_vec_env_v1(env), 2,
+                                        num_cpus=0, base_class="gymnasium")
+    obs, _ = venv.reset(seed=0)
+    assert venv.num_envs == 6 and obs.shape == (6, *env.observation_space("player").shape)
+    for _ in range(15):
+        obs, rewards, *_ = venv.step(np.zeros(6, dtype=np.int64))
+    assert rewards.shape == (6,)
