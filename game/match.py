@@ -35,8 +35,10 @@ GRID_ACTIONS = ("stay", "north", "east", "south", "west")
 PARTITION_ACTIONS = ("stay", "north", "northeast", "east", "southeast",
                      "south", "southwest", "west", "northwest")
 #: Default reward terms (see docs/api.md, "Rewards"): per second survived, per HP lost, per
-#: capture, per second seen by a guard, and per second near a guard (the weight at distance
-#: 0, falling linearly to 0 at the guards' view range, along the level's paths).
+#: capture; then shaping by the change of a potential: ``seen`` while a guard sees the
+#: player, ``proximity`` for a guard on the player's node, falling linearly to 0 at the
+#: guards' view range along the level's paths. A potential's change sums to its last
+#: value minus its first over an episode, so shaping never pays a player to die sooner.
 REWARDS = {"survival": 0.1, "hp": 1.0, "capture": 10.0, "seen": 1.0, "proximity": 3.0}
 
 
@@ -167,6 +169,7 @@ class Match:
 
         self.seed: int | None = None
         self.world = self._new_world(0)
+        self._danger = 0.0
         self.n_guards = len(self.world.guards)
         self.observer = Observer(self.level, self.graph, obs_radius, self.view_range,
                                  self.duration, self.hp_max, self.n_guards, self.moves)
@@ -197,7 +200,16 @@ class Match:
         else:
             self.seed += 1
         self.world = self._new_world(self.seed)
+        self._danger = self.danger()
         return self.info()
+
+    def danger(self) -> float:
+        """The shaping potential now (negated): ``seen`` × seen + ``proximity`` × nearness."""
+        r = self.rewards
+        out = r["seen"] * bool(self.world.seen_by)
+        if r["proximity"]:
+            out += r["proximity"] * max(0.0, 1.0 - self.guard_distance() / self.view_range)
+        return out
 
     def info(self) -> dict[str, Any]:
         """``seed``, ``t``, ``hp``, ``captures`` and the player's ``action_mask``."""
@@ -234,10 +246,8 @@ class Match:
         hp0, t0, caps0 = w.hp, w.t, w.m.captures
         staying = False
         hp = hp0
-        seen_steps = 0
         for k in range(self.max_steps):
             w.step()
-            seen_steps += bool(w.seen_by)
             if w.done or w.hp > hp:  # over, or respawned after a capture (fixed-time)
                 break
             hp = w.hp
@@ -255,13 +265,9 @@ class Match:
             lost = hp0 + (captures - 1) * self.hp_max + (self.hp_max - w.hp)
         else:
             lost = hp0 - max(0.0, w.hp)
-        elapsed = w.t - t0
-        reward = (self.rewards["survival"] * elapsed - self.rewards["hp"] * lost
-                  - self.rewards["capture"] * captures
-                  - self.rewards["seen"] * seen_steps * self.dt)
-        if self.rewards["proximity"]:
-            near = max(0.0, 1.0 - self.guard_distance() / self.view_range)
-            reward -= self.rewards["proximity"] * near * elapsed
+        danger, self._danger = self._danger, self.danger()
+        reward = (self.rewards["survival"] * (w.t - t0) - self.rewards["hp"] * lost
+                  - self.rewards["capture"] * captures + danger - self._danger)
         terminated = bool(w.done and captures and ends)
         truncated = bool(w.done and not terminated)
         return float(reward), terminated, truncated

@@ -274,19 +274,28 @@ def test_player_observation_points_at_perceived_guards() -> None:
     assert np.allclose(moves[:, 1], np.minimum(near[m.moves[w.player.node]], cap) / cap, atol=1e-5)
 
 
-def test_shaping_terms_cost_what_they_say() -> None:
-    """Same episode with and without the seen / proximity terms: the difference is theirs."""
-    actions = [0, 2, 2, 3, 1, 4, 0, 0, 2, 3] * 6
+def test_shaping_is_the_change_of_a_potential() -> None:
+    """Same episode with and without the seen / proximity terms: per step, the difference
+    is the drop of ``danger`` (seen + nearness of the nearest guard), so over an episode it
+    sums to the first value minus the last and never pays a player to be caught sooner."""
     kw = {"guards": "cheat", "world__player_hp": 1e6}  # guards that come, a player never caught
-    plain = StealthEnv("maze", rewards=UNSHAPED, **kw)
-    seen = StealthEnv("maze", rewards={"proximity": 0.0}, **kw)
-    a, b = _rollout(plain, 3, np.array(actions)), _rollout(seen, 3, np.array(actions))
-    assert all(np.array_equal(x, y) for x, y in zip(a[0], b[0], strict=True))
-    assert all(rs <= rp + 1e-12 for rp, rs in zip(a[1], b[1], strict=True))
-    assert sum(b[1]) < sum(a[1])  # seen at some point
-    shaped = StealthEnv("maze", **kw)
-    c = _rollout(shaped, 3, np.array(actions))
-    assert sum(c[1]) < sum(b[1])  # the guards come near: proximity costs
+    plain, shaped = StealthEnv("maze", rewards=UNSHAPED, **kw), StealthEnv("maze", **kw)
+    plain.reset(seed=3)
+    shaped.reset(seed=3)
+    first = previous = shaped.match.danger()
+    assert first == 0.0 or first > 0
+    dangers = []
+    for a in [0, 2, 2, 3, 1, 4, 0, 0, 2, 3] * 6:
+        _, r0, *_ = plain.step(a)
+        _, r1, *_ = shaped.step(a)
+        now = shaped.match.danger()
+        assert math.isclose(r1 - r0, previous - now, abs_tol=1e-9)
+        previous = now
+        dangers.append(now)
+    m = shaped.match
+    near = max(0.0, 1 - m.guard_distance() / m.view_range)
+    assert math.isclose(now, 1.0 * bool(m.world.seen_by) + 3.0 * near)
+    assert max(dangers) > 1.0  # the cheating guards came near and saw the player
 
 
 def test_vector_entry_point_steps_several_worlds() -> None:
