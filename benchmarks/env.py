@@ -4,7 +4,7 @@
 
 One env step is one player move (9 physics steps on the grid in the capture scenario).
 Printed beside it, measured in the same run: the reference of the plain headless world of
-the same level (``game.trial.make_world``, PF guards, the ``random`` player) in physics
+the same level (``game.trial.make_world``, PF guards, the ``evade`` player) in physics
 steps per second, and what that makes in moves per second at the env's physics steps per
 move, so the env's own share of the time is visible on any machine. ``--profile`` prints
 cProfile's top entries of the env run. Target (issue 23): ≥ 2,000 env steps/s, miami grid.
@@ -40,11 +40,11 @@ def env_rate(level: str, abstraction: str, seconds: float) -> tuple[float, float
 
 
 def world_rate(level: str, abstraction: str, seconds: float) -> float:
-    """Physics steps/s of the headless world itself (PF guards, random player)."""
+    """Physics steps/s of the headless world itself (PF guards, evade player)."""
     steps, seed = 0, 0
     start = time.perf_counter()
     while time.perf_counter() - start < seconds:
-        world = make_world(TrialSpec(level, abstraction, "pf", "random", "capture", seed))
+        world = make_world(TrialSpec(level, abstraction, "pf", "evade", "capture", seed))
         while not world.done and time.perf_counter() - start < seconds:
             world.step()
             steps += 1

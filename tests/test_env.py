@@ -17,7 +17,7 @@ pytest.importorskip("pettingzoo")
 from gymnasium.utils.env_checker import check_env  # noqa: E402
 from pettingzoo.test import parallel_api_test, parallel_seed_test  # noqa: E402
 
-from game.env import ENV_ID, StealthEnv, parallel_env  # noqa: E402
+from game.env import ENV_ID, REWARDS, StealthEnv, parallel_env  # noqa: E402
 from game.trial import TrialSpec, make_world  # noqa: E402
 
 ABSTRACTIONS = ("grid", "partition")
@@ -294,8 +294,8 @@ def test_shaping_is_the_change_of_a_potential() -> None:
         dangers.append(now)
     m = shaped.match
     near = max(0.0, 1 - m.guard_distance() / m.view_range)
-    assert math.isclose(now, 1.0 * bool(m.world.seen_by) + 3.0 * near)
-    assert max(dangers) > 1.0  # the cheating guards came near and saw the player
+    assert math.isclose(now, REWARDS["seen"] * bool(m.world.seen_by) + REWARDS["proximity"] * near)
+    assert max(dangers) > REWARDS["seen"]  # the cheating guards came near and saw the player
 
 
 def test_vector_entry_point_steps_several_worlds() -> None:
