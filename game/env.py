@@ -195,7 +195,7 @@ def parallel_env(level: str = "miami", abstraction: str = "grid", scenario: str 
     ``pad_observations=False`` gives each agent its own length.
 
     Options: ``render_mode`` (``"rgb_array"`` or ``"human"``), ``render_size`` ``(w, h)``,
-    ``obs_radius`` (half side of the observation window, default 4 cells), ``rewards``
+    ``obs_radius`` (half side of the observation window, default 2 cells), ``rewards``
     (override :data:`REWARDS` terms), ``overrides`` (``{"world.guards": 2, ...}``); any
     other keyword is a config override with ``__`` for ``.`` (``world__guards=2``).
 
