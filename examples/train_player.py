@@ -27,7 +27,7 @@ from pathlib import Path
 
 import numpy as np
 
-from game.env import OTHER_GUARD, PLAYER_CHANNELS, PLAYER_FEATURES, StealthEnv
+from game.env import PLAYER_CHANNELS, PLAYER_FEATURES, PLAYER_GUARD, StealthEnv
 from game.trial import TrialSpec, run_trial
 
 BANDS = (2.0, 4.0, 8.0)  # distance bands of the nearest perceived guard (world units)
@@ -38,10 +38,11 @@ class Tabulator:
 
     def __init__(self, env: StealthEnv) -> None:
         m = env.unwrapped.match
-        self.diag = m.diagonal
-        side = 2 * m.radius + 1
+        self.scale = m.view_range  # the player's guard offsets are in view-range units
+        r = m.observer.radius
+        side = 2 * r + 1
         self.base = len(PLAYER_CHANNELS) * side ** 2
-        r = m.radius  # the window's centre cell is the player's; N, E, S, W of it:
+        # the window's centre cell is the player's; N, E, S, W of it:
         self.around = [(r - 1) * side + r, r * side + r + 1, (r + 1) * side + r, r * side + r - 1]
         self.n_guards = m.n_guards
         self.n_states = 16 * (1 + 4 * len(BANDS)) * 2
@@ -50,11 +51,12 @@ class Tabulator:
         f = obs[self.base:]
         walls = sum(1 << k for k, i in enumerate(self.around) if obs[i] > 0.5)
         detected = int(f[PLAYER_FEATURES.index("detected")] > 0.5)
-        guards = f[len(PLAYER_FEATURES):].reshape(self.n_guards, len(OTHER_GUARD))
+        slots = f[len(PLAYER_FEATURES):len(PLAYER_FEATURES) + len(PLAYER_GUARD) * self.n_guards]
+        guards = slots.reshape(self.n_guards, len(PLAYER_GUARD))
         code = 0
         seen = guards[:, 0] > 0.5
         if seen.any():
-            d = guards[seen, 1:3] * self.diag
+            d = guards[seen, 1:3] * self.scale
             k = int(np.argmin(np.hypot(d[:, 0], d[:, 1])))
             dx, dy = d[k]
             direction = (0 if dy < 0 else 2) if abs(dy) >= abs(dx) else (1 if dx > 0 else 3)
@@ -92,8 +94,9 @@ def main() -> None:
     parser.add_argument("--out", default="docs/img/train-player-maze.png")
     args = parser.parse_args()
 
+    # the reward it was tuned and measured with: the game's terms, no shaping
     env = StealthEnv(args.level, guards=args.guards, abstraction=args.abstraction,
-                     scenario=args.scenario)
+                     scenario=args.scenario, rewards={"seen": 0.0, "proximity": 0.0})
     tab = Tabulator(env)
     q = np.zeros((tab.n_states, env.action_space.n))
     rng = np.random.default_rng(np.random.SeedSequence([args.seed, 1]))

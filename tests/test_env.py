@@ -17,10 +17,11 @@ pytest.importorskip("pettingzoo")
 from gymnasium.utils.env_checker import check_env  # noqa: E402
 from pettingzoo.test import parallel_api_test, parallel_seed_test  # noqa: E402
 
-from game.env import ENV_ID, StealthEnv, parallel_env  # noqa: E402
+from game.env import ENV_ID, REWARDS, StealthEnv, parallel_env  # noqa: E402
 from game.trial import TrialSpec, make_world  # noqa: E402
 
 ABSTRACTIONS = ("grid", "partition")
+UNSHAPED = {"seen": 0.0, "proximity": 0.0}  # the game's own terms only
 
 
 @pytest.mark.parametrize("abstraction", ABSTRACTIONS)
@@ -52,11 +53,20 @@ def test_registered_with_gymnasium() -> None:
 def test_spaces_follow_the_abstraction() -> None:
     assert StealthEnv("maze").action_space.n == 5
     assert StealthEnv("maze", abstraction="partition").action_space.n == 9
-    env = parallel_env("maze", world__guards=2, obs_radius=2)
+    env = parallel_env("maze", world__guards=2, obs_radius=2, pad_observations=False)
     assert env.possible_agents == ["player", "guard_0", "guard_1"]
-    # player: 3 channels of 5x5, 7 own features, 5 per guard; guards: 5 channels, 7, 5 each, 3
-    assert env.observation_space("player").shape == (3 * 25 + 7 + 2 * 5,)
+    # player: 3 channels of 5x5, 7 own features, 7 per guard, 2 per action;
+    # guards: 5 channels, 7, 5 per guard, 3
+    assert env.observation_space("player").shape == (3 * 25 + 7 + 2 * 7 + 5 * 2,)
     assert env.observation_space("guard_1").shape == (5 * 25 + 7 + 2 * 5 + 3,)
+    padded = parallel_env("maze", world__guards=2, obs_radius=2)  # the default: one size
+    assert all(padded.observation_space(a) == env.observation_space("guard_1")
+               for a in padded.possible_agents)
+    obs, _ = padded.reset(seed=0)
+    own = StealthEnv("maze", world__guards=2, obs_radius=2)
+    first, _ = own.reset(seed=0)
+    assert np.array_equal(obs["player"][:len(first)], first)  # the player's layout, then zeros
+    assert not obs["player"][len(first):].any()
 
 
 def _rollout(env: StealthEnv, seed: int, actions: np.ndarray) -> tuple[list, list]:
@@ -103,7 +113,7 @@ def test_episode_starts_where_the_trial_of_that_seed_starts() -> None:
 
 
 def test_a_grid_step_is_one_cell_and_stay_stays() -> None:
-    env = StealthEnv("maze", guards="random", world__player_hp=1e6)  # never captured
+    env = StealthEnv("maze", guards="random", world__player_hp=1e6, rewards=UNSHAPED)  # never captured
     env.reset(seed=2)
     world = env.match.world
     moves = env.match.moves
@@ -125,7 +135,7 @@ def test_a_grid_step_is_one_cell_and_stay_stays() -> None:
 
 
 def test_capture_ends_the_episode_with_the_penalty() -> None:
-    env = StealthEnv("maze", guards="cheat", world__guards=3)
+    env = StealthEnv("maze", guards="cheat", world__guards=3, rewards=UNSHAPED)
     env.reset(seed=0)
     total, term, trunc, info = 0.0, False, False, {}
     while not (term or trunc):
@@ -186,7 +196,8 @@ def test_bad_options_are_clear() -> None:
 
 
 def test_fixed_time_capture_respawns_and_counts_the_penalty() -> None:
-    env = StealthEnv("maze", guards="cheat", scenario="fixed", world__duration=20.0)
+    env = StealthEnv("maze", guards="cheat", scenario="fixed", world__duration=20.0,
+                     rewards=UNSHAPED)
     env.reset(seed=0)
     total, term, trunc, info = 0.0, False, False, {}
     while not (term or trunc):
@@ -195,3 +206,120 @@ def test_fixed_time_capture_respawns_and_counts_the_penalty() -> None:
     assert not term and trunc and info["captures"] >= 1 and math.isclose(info["t"], 20.0)
     lost = 3.0 * info["captures"] + (3.0 - info["hp"])
     assert math.isclose(total, 0.1 * 20.0 - lost - 10.0 * info["captures"], abs_tol=1e-6)
+
+
+@pytest.mark.parametrize("action", [-1, 5, 1.7, "2", None, np.float64(1.0)])
+def test_actions_outside_the_space_are_refused(action: object) -> None:
+    env = StealthEnv("maze")
+    env.reset(seed=0)
+    with pytest.raises(ValueError, match="invalid action"):
+        env.step(action)
+    assert env.step(np.int64(2))[4]["t"] > 0  # numpy integers are actions
+
+
+def test_parallel_env_refuses_unknown_agents_and_bad_actions() -> None:
+    env = parallel_env("maze", world__guards=2)
+    env.reset(seed=0)
+    with pytest.raises(ValueError, match="unknown agent.*guard_7"):
+        env.step({"player": 0, "guard_7": 1})
+    with pytest.raises(ValueError, match="invalid action -1 for 'guard_0'"):
+        env.step({"player": 0, "guard_0": -1})
+    env.step({"player": 1, "guard_0": 2})
+
+
+def test_action_masks_say_which_actions_move() -> None:
+    env = StealthEnv("maze")
+    _, info = env.reset(seed=0)
+    moves = env.match.moves
+    for _ in range(15):
+        node = env.match.world.player.node
+        mask = env.action_masks()
+        assert np.array_equal(mask, info["action_mask"]) and mask[0]
+        assert np.array_equal(mask[1:], moves[node, 1:] != node)
+        _, _, term, trunc, info = env.step(int(np.flatnonzero(mask)[-1]))
+        if term or trunc:
+            break
+    penv = parallel_env("maze", world__guards=2)
+    _, infos = penv.reset(seed=1)
+    g = penv.match.world.guards[1].node
+    assert np.array_equal(infos["guard_1"]["action_mask"][1:], moves[g, 1:] != g)
+    assert np.array_equal(penv.action_masks("guard_1"), infos["guard_1"]["action_mask"])
+
+
+def test_player_observation_points_at_perceived_guards() -> None:
+    """Guard slots are nearest first in view-range units; each action's safety is the path
+    distance of its target from the nearest perceived guard."""
+    from game.env import MOVE_FEATURES, PLAYER_CHANNELS, PLAYER_FEATURES, PLAYER_GUARD
+
+    env = StealthEnv("maze", guards="cheat", world__player_hp=1e6)
+    m = env.match
+    side = (2 * m.observer.radius + 1) ** 2
+    base = len(PLAYER_CHANNELS) * side + len(PLAYER_FEATURES)
+    obs, _ = env.reset(seed=0)
+    for _ in range(200):
+        slots = obs[base:base + len(PLAYER_GUARD) * m.n_guards].reshape(m.n_guards, -1)
+        if slots[0, 0] > 0:
+            break
+        obs, *_ = env.step(0)
+    else:
+        raise AssertionError("the cheating guards never came into view")
+    w = m.world
+    known = [j for j in range(m.n_guards) if m.observer.player_sees(w.view(), j)]
+    dists = sorted(math.dist(w.guards[j].pos, w.player.pos) for j in known)
+    assert np.allclose(slots[:len(known), 3], np.array(dists) / m.view_range, atol=1e-5)
+    assert (slots[len(known):] == 0).all()
+    moves = obs[base + len(PLAYER_GUARD) * m.n_guards:].reshape(-1, len(MOVE_FEATURES))
+    near = m.graph.dist_from([w.guards[j].node for j in known]).min(axis=0)
+    cap = 2 * m.view_range
+    assert np.allclose(moves[:, 1], np.minimum(near[m.moves[w.player.node]], cap) / cap, atol=1e-5)
+
+
+def test_shaping_is_the_change_of_a_potential() -> None:
+    """Same episode with and without the seen / proximity terms: per step, the difference
+    is the drop of ``danger`` (seen + nearness of the nearest guard), so over an episode it
+    sums to the first value minus the last and never pays a player to be caught sooner."""
+    kw = {"guards": "cheat", "world__player_hp": 1e6}  # guards that come, a player never caught
+    plain, shaped = StealthEnv("maze", rewards=UNSHAPED, **kw), StealthEnv("maze", **kw)
+    plain.reset(seed=3)
+    shaped.reset(seed=3)
+    first = previous = shaped.match.danger()
+    assert first == 0.0 or first > 0
+    dangers = []
+    for a in [0, 2, 2, 3, 1, 4, 0, 0, 2, 3] * 6:
+        _, r0, *_ = plain.step(a)
+        _, r1, *_ = shaped.step(a)
+        now = shaped.match.danger()
+        assert math.isclose(r1 - r0, previous - now, abs_tol=1e-9)
+        previous = now
+        dangers.append(now)
+    m = shaped.match
+    near = max(0.0, 1 - m.guard_distance() / m.view_range)
+    assert math.isclose(now, REWARDS["seen"] * bool(m.world.seen_by) + REWARDS["proximity"] * near)
+    assert max(dangers) > REWARDS["seen"]  # the cheating guards came near and saw the player
+
+
+def test_vector_entry_point_steps_several_worlds() -> None:
+    venv = gymnasium.make_vec(ENV_ID, num_envs=2, vectorization_mode="vector_entry_point",
+                              level="maze", world__duration=3.0)
+    obs, info = venv.reset(seed=4)
+    assert obs.shape == (2, *StealthEnv("maze").observation_space.shape)
+    assert list(info["seed"]) == [4, 5]
+    one, _ = StealthEnv("maze").reset(seed=5)
+    assert np.array_equal(obs[1], one)
+    assert venv.action_masks().shape == (2, 5)
+    for _ in range(10):
+        obs, rewards, *_ = venv.step(np.array([1, 2]))
+    assert obs.shape[0] == 2 and rewards.shape == (2,)
+
+
+def test_supersuit_vectorises_the_parallel_env_as_it_is() -> None:
+    """docs/api.md: SuperSuit's PettingZoo → vector env wrappers need one observation size."""
+    supersuit = pytest.importorskip("supersuit")  # the `test` extra installs it
+    env = parallel_env("maze", world__guards=2, world__duration=3.0)
+    venv = supersuit.concat_vec_envs_v1(supersuit.pettingzoo_env_to_vec_env_v1(env), 2,
+                                        num_cpus=0, base_class="gymnasium")
+    obs, _ = venv.reset(seed=0)
+    assert venv.num_envs == 6 and obs.shape == (6, *env.observation_space("player").shape)
+    for _ in range(15):
+        obs, rewards, *_ = venv.step(np.zeros(6, dtype=np.int64))
+    assert rewards.shape == (6,)

@@ -47,10 +47,36 @@ from .match import (  # re-exported: the env API names them
     ExternalPlayer,
     Match,
 )
+from .observations import (  # re-exported: the layout's names (docs/api.md)
+    GUARD_CHANNELS,
+    GUARD_FEATURES,
+    MOVE_FEATURES,
+    OTHER_GUARD,
+    PLAYER_AS_SEEN,
+    PLAYER_CHANNELS,
+    PLAYER_FEATURES,
+    PLAYER_GUARD,
+)
 
 ENV_ID = "stealthfield/Stealth-v0"
 #: Keyword options of the environments; every other keyword is a config override.
 _OPTIONS = ("render_mode", "obs_radius", "rewards", "render_size", "overrides")
+
+
+def check_action(space: spaces.Discrete, action: Any, who: str = "the agent") -> int:
+    """``action`` as an int, or a ValueError naming it when it is not in ``space``.
+
+    ``Discrete.contains`` refuses floats, strings and out-of-range integers (numpy's
+    ``-1`` included), so ``step(1.7)`` cannot silently become action 1.
+    """
+    try:
+        ok = space.contains(action)
+    except (TypeError, ValueError):
+        ok = False
+    if not ok:
+        raise ValueError(f"invalid action {action!r} for {who}: expected an integer in "
+                         f"[0, {space.n - 1}] ({space})")
+    return int(action)
 
 
 def _split_options(level: str, abstraction: str, scenario: str, kwargs: dict[str, Any]
@@ -73,13 +99,18 @@ class StealthParallelEnv(ParallelEnv):
                 "render_fps": 4, "is_parallelizable": True}
 
     def __init__(self, level: str = "miami", abstraction: str = "grid",
-                 scenario: str = "capture", **config: Any) -> None:
+                 scenario: str = "capture", pad_observations: bool = True,
+                 **config: Any) -> None:
         options, overrides = _split_options(level, abstraction, scenario, config)
         self.match = Match(level, abstraction, scenario, None, overrides, **options)
         self.render_mode = self.match.render_mode
         self.possible_agents = ["player"] + [f"guard_{i}" for i in range(self.match.n_guards)]
         self.agents: list[str] = []
-        self._obs_spaces = {a: self.match.obs_space(a != "player") for a in self.possible_agents}
+        sizes = {a: self.match.observer.obs_size(a != "player") for a in self.possible_agents}
+        #: every agent's observation length: the largest one when padding (the default)
+        self._sizes = dict.fromkeys(sizes, max(sizes.values())) if pad_observations else sizes
+        self._obs_spaces = {a: self.match.obs_space(a != "player", self._sizes[a])
+                            for a in self.possible_agents}
         self._act_spaces = {a: spaces.Discrete(self.match.n_actions) for a in self.possible_agents}
         self._fallback = np.random.default_rng()
 
@@ -94,27 +125,54 @@ class StealthParallelEnv(ParallelEnv):
         obs = {"player": self.match.observe_player()}
         for i in range(self.match.n_guards):
             obs[f"guard_{i}"] = self.match.observe_guard(view, i)
+        for agent, o in obs.items():
+            if len(o) < self._sizes[agent]:  # padded mode: zeros after the agent's own layout
+                obs[agent] = np.concatenate([o, np.zeros(self._sizes[agent] - len(o), np.float32)])
         return obs
+
+    def _infos(self) -> dict[str, dict]:
+        info = self.match.info()
+        infos = {"player": info}
+        for i, guard in enumerate(self.match.world.guards):
+            infos[f"guard_{i}"] = {**info, "action_mask": self.match.action_mask(guard.node)}
+        return {a: infos[a] for a in self.agents}
+
+    def action_masks(self, agent: str) -> np.ndarray:
+        """``agent``'s action mask now (as its ``info["action_mask"]``)."""
+        if agent == "player":
+            return self.match.action_mask()
+        return self.match.action_mask(self.match.world.guards[self._guard_index(agent)].node)
+
+    def _guard_index(self, agent: str) -> int:
+        if agent not in self.possible_agents or agent == "player":
+            raise ValueError(f"unknown agent {agent!r} (agents: {self.possible_agents})")
+        return self.possible_agents.index(agent) - 1
 
     def reset(self, seed: int | None = None, options: dict | None = None
               ) -> tuple[dict[str, np.ndarray], dict[str, dict]]:
-        info = self.match.reset(seed, self._fallback)
+        self.match.reset(seed, self._fallback)
         self.agents = list(self.possible_agents)
-        return self._observe(), {a: dict(info) for a in self.agents}
+        return self._observe(), self._infos()
 
     def step(self, actions: Mapping[str, Any]) -> tuple[dict, dict, dict, dict, dict]:
-        """Missing actions mean "stay"; guard rewards are the negated player reward."""
+        """Missing actions mean "stay"; guard rewards are the negated player reward.
+
+        An unknown agent or an action outside the agent's space is a ValueError naming it.
+        """
         if not self.agents:
             raise RuntimeError("step() after the episode ended: call reset()")
-        guard_actions = np.array([int(actions.get(f"guard_{i}", 0))
+        unknown = [a for a in actions if a not in self.agents]
+        if unknown:
+            raise ValueError(f"unknown agent(s) {unknown} (agents: {self.agents})")
+        chosen = {a: check_action(self._act_spaces[a], act, repr(a)) for a, act in actions.items()}
+        guard_actions = np.array([chosen.get(f"guard_{i}", 0)
                                   for i in range(self.match.n_guards)], dtype=np.int64)
-        reward, terminated, truncated = self.match.step(int(actions.get("player", 0)), guard_actions)
+        reward, terminated, truncated = self.match.step(chosen.get("player", 0), guard_actions)
         obs = self._observe()
         rewards = {a: (reward if a == "player" else -reward) for a in self.agents}
         terms = dict.fromkeys(self.agents, terminated)
         truncs = dict.fromkeys(self.agents, truncated)
-        info = self.match.info()
-        infos = {a: dict(info) for a in self.agents}
+        infos = self._infos()
         if terminated or truncated:
             self.agents = []
         if self.render_mode == "human":
@@ -129,11 +187,15 @@ class StealthParallelEnv(ParallelEnv):
 
 
 def parallel_env(level: str = "miami", abstraction: str = "grid", scenario: str = "capture",
-                 **config: Any) -> StealthParallelEnv:
+                 pad_observations: bool = True, **config: Any) -> StealthParallelEnv:
     """A PettingZoo ``ParallelEnv`` of one level: agents ``"player"``, ``"guard_0"``, ...
 
+    Every agent's observation has the same length (the guards', the longest; the player's
+    is padded with zeros) so that SuperSuit's vector wrappers take the env as it is;
+    ``pad_observations=False`` gives each agent its own length.
+
     Options: ``render_mode`` (``"rgb_array"`` or ``"human"``), ``render_size`` ``(w, h)``,
-    ``obs_radius`` (half side of the observation window, default 4 cells), ``rewards``
+    ``obs_radius`` (half side of the observation window, default 2 cells), ``rewards``
     (override :data:`REWARDS` terms), ``overrides`` (``{"world.guards": 2, ...}``); any
     other keyword is a config override with ``__`` for ``.`` (``world__guards=2``).
 
@@ -141,7 +203,7 @@ def parallel_env(level: str = "miami", abstraction: str = "grid", scenario: str 
     >>> env.possible_agents
     ['player', 'guard_0', 'guard_1']
     """
-    return StealthParallelEnv(level, abstraction, scenario, **config)
+    return StealthParallelEnv(level, abstraction, scenario, pad_observations, **config)
 
 
 # ---------------------------------------------------------------------------- Gymnasium
@@ -167,7 +229,8 @@ class StealthEnv(gymnasium.Env):
         self.match = Match(level, abstraction, scenario, guards, overrides, **options)
         self.render_mode = self.match.render_mode
         self.observation_space = self.match.obs_space(False)
-        self.action_space = spaces.Discrete(self.match.n_actions)
+        self._actions = spaces.Discrete(self.match.n_actions)
+        self.action_space = self._actions
 
     def reset(self, *, seed: int | None = None, options: dict | None = None
               ) -> tuple[np.ndarray, dict[str, Any]]:
@@ -175,8 +238,14 @@ class StealthEnv(gymnasium.Env):
         info = self.match.reset(seed, self.np_random)
         return self.match.observe_player(), info
 
+    def action_masks(self) -> np.ndarray:
+        """Which actions move the player now (sb3-contrib's ``MaskablePPO`` reads this)."""
+        return self.match.action_mask()
+
     def step(self, action: Any) -> tuple[np.ndarray, float, bool, bool, dict[str, Any]]:
-        reward, terminated, truncated = self.match.step(int(action))
+        """One player move; an action outside ``action_space`` is a ValueError naming it."""
+        action = check_action(self._actions, action, "the player")
+        reward, terminated, truncated = self.match.step(action)
         obs = self.match.observe_player()
         if self.render_mode == "human":
             self.match.render()
@@ -189,8 +258,30 @@ class StealthEnv(gymnasium.Env):
         self.match.close()
 
 
-if ENV_ID not in gymnasium.registry:
-    gymnasium.register(id=ENV_ID, entry_point="game.env:StealthEnv")
+class StealthVectorEnv(gymnasium.vector.SyncVectorEnv):
+    """``num_envs`` :class:`StealthEnv` worlds stepped in turn in this process.
 
-__all__ = ["parallel_env", "StealthParallelEnv", "StealthEnv", "ExternalPlayer",
-           "ExternalGuards", "ENV_ID", "GRID_ACTIONS", "PARTITION_ACTIONS", "REWARDS"]
+    What ``gymnasium.make_vec("stealthfield/Stealth-v0", num_envs=n,
+    vectorization_mode="vector_entry_point", level=...)`` builds: the worlds share the
+    level, its graph and its move table (cached per process), so n worlds cost one level's
+    set-up; ``reset(seed=s)`` plays seeds ``s, s + 1, ...``; ``action_masks()`` stacks the
+    worlds' masks (n, actions).
+    """
+
+    def __init__(self, num_envs: int = 1, **kwargs: Any) -> None:
+        if int(num_envs) < 1:
+            raise ValueError(f"num_envs must be >= 1, not {num_envs!r}")
+        super().__init__([lambda: StealthEnv(**kwargs) for _ in range(int(num_envs))])
+
+    def action_masks(self) -> np.ndarray:
+        return np.stack([env.unwrapped.action_masks() for env in self.envs])  # type: ignore[attr-defined]
+
+
+if ENV_ID not in gymnasium.registry:
+    gymnasium.register(id=ENV_ID, entry_point="game.env:StealthEnv",
+                       vector_entry_point="game.env:StealthVectorEnv")
+
+__all__ = ["ENV_ID", "GRID_ACTIONS", "GUARD_CHANNELS", "GUARD_FEATURES", "MOVE_FEATURES",
+           "OTHER_GUARD", "PARTITION_ACTIONS", "PLAYER_AS_SEEN", "PLAYER_CHANNELS",
+           "PLAYER_FEATURES", "PLAYER_GUARD", "REWARDS", "ExternalGuards", "ExternalPlayer",
+           "StealthEnv", "StealthParallelEnv", "StealthVectorEnv", "check_action", "parallel_env"]

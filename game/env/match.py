@@ -34,8 +34,12 @@ GRID_ACTIONS = ("stay", "north", "east", "south", "west")
 #: Partition actions (Discrete(9)): stay and eight compass directions.
 PARTITION_ACTIONS = ("stay", "north", "northeast", "east", "southeast",
                      "south", "southwest", "west", "northwest")
-#: Default reward terms (see docs/api.md, "Rewards").
-REWARDS = {"survival": 0.1, "hp": 1.0, "capture": 10.0}
+#: Default reward terms (see docs/api.md, "Rewards"): per second survived, per HP lost, per
+#: capture; then shaping by the change of a potential: ``seen`` while a guard sees the
+#: player, ``proximity`` for a guard on the player's node, falling linearly to 0 at the
+#: guards' view range along the level's paths. A potential's change sums to its last
+#: value minus its first over an episode, so shaping never pays a player to die sooner.
+REWARDS = {"survival": 0.1, "hp": 1.0, "capture": 10.0, "seen": 2.0, "proximity": 6.0}
 
 
 def _direction_table(graph: NodeGraph) -> np.ndarray:
@@ -131,7 +135,7 @@ class Match:
     """
 
     def __init__(self, level: str, abstraction: str, scenario: str, guard_mode: str | None,
-                 overrides: Mapping[str, Any], obs_radius: int = 4,
+                 overrides: Mapping[str, Any], obs_radius: int = 2,
                  rewards: Mapping[str, float] | None = None,
                  render_mode: str | None = None,
                  render_size: tuple[int, int] | None = None) -> None:
@@ -165,9 +169,10 @@ class Match:
 
         self.seed: int | None = None
         self.world = self._new_world(0)
+        self._danger = 0.0
         self.n_guards = len(self.world.guards)
         self.observer = Observer(self.level, self.graph, obs_radius, self.view_range,
-                                 self.duration, self.hp_max, self.n_guards)
+                                 self.duration, self.hp_max, self.n_guards, self.moves)
         self._renderer: Any = None
 
     # ------------------------------------------------------------------ episodes
@@ -194,12 +199,39 @@ class Match:
         else:
             self.seed += 1
         self.world = self._new_world(self.seed)
+        self._danger = self.danger()
         return self.info()
 
+    def danger(self) -> float:
+        """The shaping potential now (negated): ``seen`` × seen + ``proximity`` × nearness."""
+        r = self.rewards
+        out = r["seen"] * bool(self.world.seen_by)
+        if r["proximity"]:
+            out += r["proximity"] * max(0.0, 1.0 - self.guard_distance() / self.view_range)
+        return out
+
     def info(self) -> dict[str, Any]:
+        """``seed``, ``t``, ``hp``, ``captures`` and the player's ``action_mask``."""
         w = self.world
         return {"seed": self.seed, "t": round(w.t, 6), "hp": round(w.hp, 6),
-                "captures": w.metrics()["captures"]}
+                "captures": w.m.captures, "action_mask": self.action_mask()}
+
+    def action_mask(self, node: int | None = None) -> np.ndarray:
+        """Which actions move the agent on ``node`` (default: the player's); stay always can.
+
+        An action masked out is legal all the same (it stays): the mask only tells a
+        masking learner which actions are worth trying.
+        """
+        row = self.moves[self.world.player.node if node is None else node]
+        mask = row != row[0]
+        mask[0] = True
+        return mask
+
+    def guard_distance(self) -> float:
+        """Path distance from the player's node to the nearest active guard's (inf if none)."""
+        w = self.world
+        nodes = [g.node for g in w.guards if g.active]
+        return self.graph.nearest_dist_to(nodes, w.player.node) if nodes else math.inf
 
     def step(self, player_action: int, guard_actions: np.ndarray | None = None
              ) -> tuple[float, bool, bool]:
@@ -210,7 +242,7 @@ class Match:
         self.player.action, self.player.decisions = int(player_action), 0
         if self.guards is not None and guard_actions is not None:
             self.guards.actions[:] = guard_actions
-        hp0, t0, caps0 = w.hp, w.t, w.metrics()["captures"]
+        hp0, t0, caps0 = w.hp, w.t, w.m.captures
         staying = False
         hp = hp0
         for k in range(self.max_steps):
@@ -226,14 +258,15 @@ class Match:
                         break
                 elif self.player.decisions > 1 or self._at(self.player.target):
                     break
-        captures = w.metrics()["captures"] - caps0
+        captures = w.m.captures - caps0
         ends = bool(self.config[f"scenario.{self.scenario}.end_on_capture"])
         if captures and not ends:  # fixed-time: the player respawned with full HP
             lost = hp0 + (captures - 1) * self.hp_max + (self.hp_max - w.hp)
         else:
             lost = hp0 - max(0.0, w.hp)
+        danger, self._danger = self._danger, self.danger()
         reward = (self.rewards["survival"] * (w.t - t0) - self.rewards["hp"] * lost
-                  - self.rewards["capture"] * captures)
+                  - self.rewards["capture"] * captures + danger - self._danger)
         terminated = bool(w.done and captures and ends)
         truncated = bool(w.done and not terminated)
         return float(reward), terminated, truncated
@@ -252,9 +285,10 @@ class Match:
         """Guard ``i``'s observation of ``view``: what the team knows plus its fields."""
         return self.observer.observe_guard(self.world, view, i, self.guards)
 
-    def obs_space(self, guard: bool) -> spaces.Box:
-        return spaces.Box(-OBS_BOUND, OBS_BOUND, shape=(self.observer.obs_size(guard),),
-                          dtype=np.float32)
+    def obs_space(self, guard: bool, size: int | None = None) -> spaces.Box:
+        """The observation space of the player or a guard (``size``: a padded length)."""
+        size = self.observer.obs_size(guard) if size is None else size
+        return spaces.Box(-OBS_BOUND, OBS_BOUND, shape=(size,), dtype=np.float32)
 
     # ------------------------------------------------------------------ rendering
     def render(self) -> np.ndarray | None:

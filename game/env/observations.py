@@ -2,7 +2,10 @@
 
 A window of ``(2r+1)²`` cells around the agent (channels :data:`PLAYER_CHANNELS` or
 :data:`GUARD_CHANNELS`) followed by the agent's own features and what it knows of the
-others; every entry lies in ``[-OBS_BOUND, OBS_BOUND]``.
+others; every entry lies in ``[-OBS_BOUND, OBS_BOUND]``. The player's guards are given
+relative to it in view-range units, nearest first, and each of its actions with how far its
+target lies from the guards it perceives (:data:`PLAYER_GUARD`, :data:`MOVE_FEATURES`): what
+a policy needs to step away from a guard without learning the level's geometry first.
 """
 
 from __future__ import annotations
@@ -22,8 +25,9 @@ from navmesh.level import Level
 if TYPE_CHECKING:
     from ..world import World
 
-__all__ = ["GUARD_CHANNELS", "GUARD_FEATURES", "OBS_BOUND", "OTHER_GUARD", "Observer",
-           "PLAYER_AS_SEEN", "PLAYER_CHANNELS", "PLAYER_FEATURES", "active_guards"]
+__all__ = ["GUARD_CHANNELS", "GUARD_FEATURES", "MOVE_FEATURES", "OBS_BOUND", "OTHER_GUARD",
+           "Observer", "PLAYER_AS_SEEN", "PLAYER_CHANNELS", "PLAYER_FEATURES", "PLAYER_GUARD",
+           "active_guards"]
 
 #: Every observation entry lies in [-OBS_BOUND, OBS_BOUND] (most in [-1, 1]).
 OBS_BOUND = 10.0
@@ -33,6 +37,11 @@ GUARD_CHANNELS = ("walkable", "player", "guards", "information", "confidence")
 PLAYER_FEATURES = ("x", "y", "cos_heading", "sin_heading", "hp", "time", "detected")
 GUARD_FEATURES = ("x", "y", "cos_heading", "sin_heading", "player_hp", "time", "sees_player")
 OTHER_GUARD = ("known", "dx", "dy", "cos_heading", "sin_heading")
+#: The player's slot per guard, nearest perceived guard first (offsets ÷ view range).
+PLAYER_GUARD = ("known", "dx", "dy", "distance", "cos_heading", "sin_heading", "facing")
+#: The player's features per action: it moves (not stay / into a wall), and the path
+#: distance from its target to the nearest perceived guard ÷ (2 × view range), at most 1.
+MOVE_FEATURES = ("open", "safety")
 PLAYER_AS_SEEN = ("known", "dx", "dy")
 
 
@@ -47,10 +56,11 @@ class Observer:
     """Encodes what the player or a guard perceives of one level as a flat array."""
 
     def __init__(self, level: Level, graph: NodeGraph, radius: int, view_range: float,
-                 duration: float, hp_max: float, n_guards: int) -> None:
+                 duration: float, hp_max: float, n_guards: int, moves: np.ndarray) -> None:
         if radius < 0:
             raise ValueError("obs_radius must be >= 0")
         self.level, self.radius, self.view_range = level, int(radius), view_range
+        self.graph, self.moves = graph, moves
         self.duration, self.hp_max, self.n_guards = duration, hp_max, n_guards
         rows, cols = level.rows, level.cols
         cs = level.cell_size
@@ -113,13 +123,35 @@ class Observer:
         pos = view.player_pos
         win, row, col = self._window(pos, len(PLAYER_CHANNELS))
         self._mark(win, 1, row, col, pos)
-        known = [self.player_sees(view, j) for j in range(self.n_guards)]
-        for j in range(self.n_guards):
-            if known[j]:
-                self._mark(win, 2, row, col, view.guard_positions[j])
+        known = [j for j in range(self.n_guards) if self.player_sees(view, j)]
+        for j in known:
+            self._mark(win, 2, row, col, view.guard_positions[j])
         heading = world.player.heading
         vec = self._self_features(world, pos, heading, view) + [float(bool(view.seen_by))]
-        vec += self._guard_features(view, pos, known)
+        scale = self.view_range
+        slots = []
+        for j in known:
+            d = view.guard_positions[j] - pos
+            dist = math.hypot(d[0], d[1])
+            h = float(view.guard_headings[j])
+            # facing: cos of the angle between the guard's heading and its line to the player
+            facing = 1.0 if dist < 1e-9 else -(d[0] * math.cos(h) + d[1] * math.sin(h)) / dist
+            slots.append((dist, [1.0, d[0] / scale, d[1] / scale, dist / scale,
+                                 math.cos(h), math.sin(h), facing]))
+        slots.sort(key=lambda slot: slot[0])
+        for _, slot in slots:
+            vec += slot
+        vec += [0.0] * (len(PLAYER_GUARD) * (self.n_guards - len(slots)))
+        node = int(view.player_node)
+        targets = self.moves[node]
+        cap = 2.0 * scale
+        if known:
+            near = self.graph.nearest_dist(view.guard_nodes[known], limit=cap)[targets]
+            safety = np.minimum(near, cap) / cap
+        else:
+            safety = np.ones(len(targets))
+        for a, target in enumerate(targets):
+            vec += [float(a == 0 or target != node), float(safety[a])]
         return self._pack(win, vec)
 
     def observe_guard(self, world: World, view: WorldView, i: int,
@@ -159,4 +191,5 @@ class Observer:
         if guard:
             return (len(GUARD_CHANNELS) * side + len(GUARD_FEATURES)
                     + len(OTHER_GUARD) * self.n_guards + len(PLAYER_AS_SEEN))
-        return len(PLAYER_CHANNELS) * side + len(PLAYER_FEATURES) + len(OTHER_GUARD) * self.n_guards
+        return (len(PLAYER_CHANNELS) * side + len(PLAYER_FEATURES)
+                + len(PLAYER_GUARD) * self.n_guards + len(MOVE_FEATURES) * self.moves.shape[1])
