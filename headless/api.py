@@ -7,8 +7,8 @@ directory, resumable), :func:`load_store` reads a results directory as rows — 
 the world of one trial, to step by hand.
 
 >>> row = run_one("maze", guards="random", seed=1, overrides={"world.duration": 3.0})
->>> sorted(row["metrics"])[:3]
-['avg_guard_player_dist', 'backtracks', 'capture_time']
+>>> sorted(row["metrics"])[:4]
+['avg_guard_player_dist', 'backtracks', 'backtracks_entries', 'backtracks_targets']
 """
 
 from __future__ import annotations
