@@ -77,20 +77,29 @@ class Clearance:
         self.level, self.radius = level, float(radius)
         self._paths: OrderedDict[tuple[float, float, float, float], tuple[tuple[float, float], ...]] = (
             OrderedDict())
-        rows, cols = level.occupancy.shape
-        self.right_clear = np.zeros((rows, cols), dtype=bool)
-        self.down_clear = np.zeros((rows, cols), dtype=bool)
-        occ = level.occupancy
-        right = occ[:, :-1] & occ[:, 1:]
-        down = occ[:-1, :] & occ[1:, :]
-        self.right_clear[:, :-1] = right
-        self.down_clear[:-1, :] = down
-        for mask, (dr, dc) in ((self.right_clear, (0, 1)), (self.down_clear, (1, 0))):
-            r, c = np.nonzero(mask)
-            if r.size:
-                a = (np.column_stack([c, r]) + 0.5) * level.cell_size
-                b = (np.column_stack([c + dc, r + dr]) + 0.5) * level.cell_size
-                mask[r, c] = self.clear_moves(a, b)
+
+    @cached_property
+    def right_clear(self) -> np.ndarray:
+        """(rows, cols): whether the body moves clear from each cell to the one on its right."""
+        return self._clear_grid_moves(0, 1)
+
+    @cached_property
+    def down_clear(self) -> np.ndarray:
+        """(rows, cols): whether the body moves clear from each cell to the one below it."""
+        return self._clear_grid_moves(1, 0)
+
+    def _clear_grid_moves(self, dr: int, dc: int) -> np.ndarray:
+        # computed on first use: validate's report() needs no grid moves
+        occ, size = self.level.occupancy, self.level.cell_size
+        rows, cols = occ.shape
+        mask = np.zeros((rows, cols), dtype=bool)
+        mask[:rows - dr, :cols - dc] = occ[:rows - dr, :cols - dc] & occ[dr:, dc:]
+        r, c = np.nonzero(mask)
+        if r.size:
+            a = (np.column_stack([c, r]) + 0.5) * size
+            b = (np.column_stack([c + dc, r + dr]) + 0.5) * size
+            mask[r, c] = self.clear_moves(a, b)
+        return mask
 
     # ------------------------------------------------------------------ swept-disc test
     @cached_property
@@ -223,23 +232,16 @@ class Clearance:
 
     # ------------------------------------------------------------------ validation
     def report(self) -> BodyReport:
-        """Narrow passages (warnings) and the pieces of the eroded area (error if several)."""
-        r = self.radius
-        eroded = self.eroded(r)
-        pieces = sorted((g for g in shapely.get_parts(eroded)
-                         if isinstance(g, Polygon) and g.area > _AREA_EPS),
-                        key=lambda g: -g.area)
-        opened = eroded.buffer(r, join_style="mitre")
-        lost = self.level.walkable.difference(opened)
-        narrow = []
-        for part in shapely.get_parts(lost):
-            if part.area <= _AREA_EPS:
-                continue
-            thin = part.buffer(-1e-3)
-            if thin.is_empty:  # a sliver along a wall, not a passage
-                continue
-            p = part.representative_point()
-            narrow.append((round(float(p.x), 1), round(float(p.y), 1)))
+        """Narrow passages (warnings) and the pieces of the eroded area (error if several);
+        a walkable area of many holes is checked group by group (:mod:`navmesh.body_report`)."""
+        from navmesh.body_report import LOCAL_MIN_HOLES, exact_parts, local_parts
+
+        r, walkable = self.radius, self.level.walkable
+        if isinstance(walkable, Polygon) and len(walkable.interiors) > LOCAL_MIN_HOLES:
+            narrow, pieces = local_parts(walkable, r)
+        else:
+            narrow, pieces = exact_parts(walkable, r)
+            pieces.sort(key=lambda g: -g.area)
         points = tuple((round(float(g.representative_point().x), 1),
                         round(float(g.representative_point().y), 1)) for g in pieces)
         return BodyReport(r, tuple(sorted(set(narrow))), tuple(g.area for g in pieces), points)
