@@ -34,7 +34,8 @@ if TYPE_CHECKING:
     from navmesh.level import Level
     from navmesh.mesh import NavMesh
 
-__all__ = ["DEFAULT_AGENT_RADIUS", "PATH_MARGIN", "BodyReport", "Clearance", "clearance_for"]
+__all__ = ["DEFAULT_AGENT_RADIUS", "PATH_MARGIN", "BodyReport", "Clearance", "check_body",
+           "clearance_for"]
 
 #: ``world.agent_radius`` of game/defaults.toml (tests/test_bounds_geometry.py checks they
 #: agree): the body graphs are built for when a caller has no config at hand.
@@ -75,6 +76,7 @@ class Clearance:
 
     def __init__(self, level: Level, radius: float) -> None:
         self.level, self.radius = level, float(radius)
+        self._report: BodyReport | None = None
         self._paths: OrderedDict[tuple[float, float, float, float], tuple[tuple[float, float], ...]] = (
             OrderedDict())
 
@@ -233,7 +235,13 @@ class Clearance:
     # ------------------------------------------------------------------ validation
     def report(self) -> BodyReport:
         """Narrow passages (warnings) and the pieces of the eroded area (error if several);
-        a walkable area of many holes is checked group by group (:mod:`navmesh.body_report`)."""
+        a walkable area of many holes is checked group by group (:mod:`navmesh.body_report`).
+        Computed once per :class:`Clearance` (every command checks it, every trial too)."""
+        if self._report is None:
+            self._report = self._compute_report()
+        return self._report
+
+    def _compute_report(self) -> BodyReport:
         from navmesh.body_report import LOCAL_MIN_HOLES, exact_parts, local_parts
 
         r, walkable = self.radius, self.level.walkable
@@ -245,6 +253,22 @@ class Clearance:
         points = tuple((round(float(g.representative_point().x), 1),
                         round(float(g.representative_point().y), 1)) for g in pieces)
         return BodyReport(r, tuple(sorted(set(narrow))), tuple(g.area for g in pieces), points)
+
+
+def check_body(level: Level, radius: float, source: str | None = None) -> BodyReport:
+    """The level check every command shares (``validate``, ``sim``, ``run``, ``play``, the
+    world): a body of ``radius`` must reach the whole walkable area, else a one-line
+    :class:`~navmesh.errors.LevelError`. Returns the report (its narrow spots are warnings)."""
+    from navmesh.errors import LevelError
+
+    report = clearance_for(level, radius).report()
+    if not report.connected:
+        where = ", ".join(f"({x:.1f}, {y:.1f})" for x, y in report.piece_points[:4])
+        src = source or (level.path.name if level.path is not None else level.name)
+        raise LevelError(src, "walkable area",
+                         f"an agent of radius {radius:g} cannot reach the whole level: it is "
+                         f"in {len(report.pieces)} pieces for its body (near {where})")
+    return report
 
 
 @dataclass(frozen=True)
