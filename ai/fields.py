@@ -28,7 +28,7 @@ from __future__ import annotations
 
 import time
 import weakref
-from collections import deque
+from collections import OrderedDict, deque
 from collections.abc import Generator, Sequence
 from functools import cached_property
 from typing import NamedTuple
@@ -268,15 +268,21 @@ class FieldMatrices:
         return cols, weights
 
 
-_MATRIX_CACHE: weakref.WeakKeyDictionary[NodeGraph, dict[tuple[float, ...], FieldMatrices]] = (
+_MATRIX_CACHE: weakref.WeakKeyDictionary[NodeGraph, OrderedDict[tuple[float, ...], FieldMatrices]] = (
     weakref.WeakKeyDictionary()
 )
+
+#: Parameter sets whose matrices one graph keeps (least recently used dropped first): a
+#: design or a tuner that varies ``pf.gamma_*``, ``kernel_*`` or ``r_edge_factor`` per trial
+#: would otherwise keep every set's kernel and row caches for the life of the process
+MATRICES_PER_GRAPH = 4
 
 
 def field_matrices(graph: NodeGraph, params: PFParams) -> FieldMatrices:
     """The precomputed matrices of ``graph`` for ``params``, built on first use and cached.
 
-    The cache holds the graph weakly, so a graph that is no longer used frees its matrices.
+    The cache holds the graph weakly, so a graph that is no longer used frees its matrices,
+    and at most :data:`MATRICES_PER_GRAPH` parameter sets per graph.
     """
     key = (
         params.gamma_I,
@@ -285,11 +291,15 @@ def field_matrices(graph: NodeGraph, params: PFParams) -> FieldMatrices:
         float(params.kernel_radius),
         params.r_edge_factor,
     )
-    per_graph = _MATRIX_CACHE.setdefault(graph, {})
+    per_graph = _MATRIX_CACHE.setdefault(graph, OrderedDict())
     matrices = per_graph.get(key)
     if matrices is None:
         matrices = FieldMatrices(graph, params)
         per_graph[key] = matrices
+        while len(per_graph) > MATRICES_PER_GRAPH:
+            per_graph.popitem(last=False)
+    else:
+        per_graph.move_to_end(key)
     return matrices
 
 
