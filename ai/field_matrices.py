@@ -9,6 +9,7 @@ storage), the kernel (:mod:`ai.kernel`), the connectivity field, the candidate s
 from __future__ import annotations
 
 import weakref
+from collections import OrderedDict
 from collections.abc import Sequence
 from functools import cached_property
 
@@ -128,15 +129,21 @@ class FieldMatrices:
         return self._kernel_rows.get(node, lambda: kernel_block(self.kernel, self.candidates[node]))
 
 
-_MATRIX_CACHE: weakref.WeakKeyDictionary[NodeGraph, dict[tuple[float, ...], FieldMatrices]] = (
+_MATRIX_CACHE: weakref.WeakKeyDictionary[NodeGraph, OrderedDict[tuple[float, ...], FieldMatrices]] = (
     weakref.WeakKeyDictionary()
 )
+
+#: Parameter sets whose matrices one graph keeps (least recently used dropped first): a
+#: design or a tuner that varies ``pf.gamma_*``, ``kernel_*`` or ``r_edge_factor`` per trial
+#: would otherwise keep every set's kernel and row caches for the life of the process
+MATRICES_PER_GRAPH = 4
 
 
 def field_matrices(graph: NodeGraph, params: PFParams) -> FieldMatrices:
     """The precomputed matrices of ``graph`` for ``params``, built on first use and cached.
 
-    The cache holds the graph weakly, so a graph that is no longer used frees its matrices.
+    The cache holds the graph weakly, so a graph that is no longer used frees its matrices,
+    and at most :data:`MATRICES_PER_GRAPH` parameter sets per graph.
     """
     key = (
         params.gamma_I,
@@ -145,12 +152,16 @@ def field_matrices(graph: NodeGraph, params: PFParams) -> FieldMatrices:
         float(params.kernel_radius),
         params.r_edge_factor,
     )
-    per_graph = _MATRIX_CACHE.setdefault(graph, {})
+    per_graph = _MATRIX_CACHE.setdefault(graph, OrderedDict())
     matrices = per_graph.get(key)
     if matrices is None:
         matrices = FieldMatrices(graph, params)
         per_graph[key] = matrices
+        while len(per_graph) > MATRICES_PER_GRAPH:
+            per_graph.popitem(last=False)
+    else:
+        per_graph.move_to_end(key)
     return matrices
 
 
-__all__ = ["SPREAD_CACHE_BYTES", "SPREAD_TOLERANCE", "FieldMatrices", "field_matrices"]
+__all__ = ["MATRICES_PER_GRAPH", "SPREAD_CACHE_BYTES", "SPREAD_TOLERANCE", "FieldMatrices", "field_matrices"]

@@ -28,6 +28,7 @@ from ai.params import FSMParams, PFParams, PlayerParams, StalenessParams
 from ai.radio import RadioParams
 from ai.roles import RoleParams
 from ai.stimuli import StimulusParams, Zone, zones_from_config
+from navmesh.clearance import check_body
 from navmesh.level import ZONE_KINDS
 
 from .actions import ActionParams
@@ -182,7 +183,9 @@ def check_sections(values: Mapping[str, Any]) -> None:
 def check_level(config: Config, level: Level) -> None:
     """What a level bounds: an agent's body must pass a one-cell corridor, so
     ``world.agent_radius`` must be below half the level's cell size (both abstractions:
-    the level is drawn on that grid). Raises :class:`ConfigError`.
+    the level is drawn on that grid). Raises :class:`ConfigError`; a level whose walkable
+    area that body cannot cross raises :class:`~navmesh.errors.LevelError`, the same check
+    as ``stealth validate`` (:func:`navmesh.clearance.check_body`).
     """
     radius = float(config["world.agent_radius"])
     half = level.cell_size / 2
@@ -190,6 +193,7 @@ def check_level(config: Config, level: Level) -> None:
         raise ConfigError(
             f"world.agent_radius = {radius:g}: must be below half the cell size of level "
             f"{level.name!r} ({half:g}), or an agent cannot pass a one-cell corridor")
+    check_body(level, radius)  # and reach the whole walkable area: validate's check too
 
 
 def markdown_table(keys: Iterable[str]) -> str:

@@ -145,23 +145,23 @@ def cmd_validate(args: argparse.Namespace) -> int:
 
 def _body_fits(name: str, level: Any) -> bool:
     """Warn of passages narrower than an agent (``world.agent_radius``); False, after one
-    error line, when the walkable area is disconnected for its body."""
+    error line, when the walkable area is disconnected for its body (the check every
+    command shares: :func:`navmesh.clearance.check_body`)."""
     from game.config import Config
-    from navmesh.clearance import clearance_for
+    from navmesh.clearance import check_body
+    from navmesh.errors import LevelError
 
     radius = float(Config.defaults()["world.agent_radius"])
-    report = clearance_for(level, radius).report()
     src = Path(name).name if Path(name).suffix else name
+    try:
+        report = check_body(level, radius, src)
+    except LevelError as error:
+        print(f"stealth: error: {error}", file=sys.stderr)
+        return False
     for x, y in report.narrow:
         print(f"{src}: warning: passage narrower than {2 * radius:g} units near ({x:.1f}, {y:.1f})",
               file=sys.stderr)
-    if report.connected:
-        return True
-    where = ", ".join(f"({x:.1f}, {y:.1f})" for x, y in report.piece_points[:4])
-    print(f"stealth: error: {src}: walkable area: an agent of radius {radius:g} cannot reach "
-          f"the whole level: it is in {len(report.pieces)} pieces for its body (near {where})",
-          file=sys.stderr)
-    return False
+    return True
 
 
 # ---------------------------------------------------------------------- path

@@ -404,7 +404,7 @@ def parse_preset(
             raise _fail(src, "levels", f"two levels are named {level.name!r}")
         try:
             check_level(config, level)
-        except ConfigError as error:
+        except (ConfigError, LevelError) as error:
             raise _fail(src, "set", str(error)) from None
         for abstraction in abstractions:
             try:

@@ -34,7 +34,8 @@ if TYPE_CHECKING:
     from navmesh.level import Level
     from navmesh.mesh import NavMesh
 
-__all__ = ["DEFAULT_AGENT_RADIUS", "PATH_MARGIN", "BodyReport", "Clearance", "clearance_for"]
+__all__ = ["DEFAULT_AGENT_RADIUS", "PATH_MARGIN", "BodyReport", "Clearance", "check_body",
+           "clearance_for"]
 
 #: ``world.agent_radius`` of game/defaults.toml (tests/test_bounds_geometry.py checks they
 #: agree): the body graphs are built for when a caller has no config at hand.
@@ -75,22 +76,32 @@ class Clearance:
 
     def __init__(self, level: Level, radius: float) -> None:
         self.level, self.radius = level, float(radius)
+        self._report: BodyReport | None = None
         self._paths: OrderedDict[tuple[float, float, float, float], tuple[tuple[float, float], ...]] = (
             OrderedDict())
-        rows, cols = level.occupancy.shape
-        self.right_clear = np.zeros((rows, cols), dtype=bool)
-        self.down_clear = np.zeros((rows, cols), dtype=bool)
-        occ = level.occupancy
-        right = occ[:, :-1] & occ[:, 1:]
-        down = occ[:-1, :] & occ[1:, :]
-        self.right_clear[:, :-1] = right
-        self.down_clear[:-1, :] = down
-        for mask, (dr, dc) in ((self.right_clear, (0, 1)), (self.down_clear, (1, 0))):
-            r, c = np.nonzero(mask)
-            if r.size:
-                a = (np.column_stack([c, r]) + 0.5) * level.cell_size
-                b = (np.column_stack([c + dc, r + dr]) + 0.5) * level.cell_size
-                mask[r, c] = self.clear_moves(a, b)
+
+    @cached_property
+    def right_clear(self) -> np.ndarray:
+        """(rows, cols): whether the body moves clear from each cell to the one on its right."""
+        return self._clear_grid_moves(0, 1)
+
+    @cached_property
+    def down_clear(self) -> np.ndarray:
+        """(rows, cols): whether the body moves clear from each cell to the one below it."""
+        return self._clear_grid_moves(1, 0)
+
+    def _clear_grid_moves(self, dr: int, dc: int) -> np.ndarray:
+        # computed on first use: validate's report() needs no grid moves
+        occ, size = self.level.occupancy, self.level.cell_size
+        rows, cols = occ.shape
+        mask = np.zeros((rows, cols), dtype=bool)
+        mask[:rows - dr, :cols - dc] = occ[:rows - dr, :cols - dc] & occ[dr:, dc:]
+        r, c = np.nonzero(mask)
+        if r.size:
+            a = (np.column_stack([c, r]) + 0.5) * size
+            b = (np.column_stack([c + dc, r + dr]) + 0.5) * size
+            mask[r, c] = self.clear_moves(a, b)
+        return mask
 
     # ------------------------------------------------------------------ swept-disc test
     @cached_property
@@ -223,26 +234,41 @@ class Clearance:
 
     # ------------------------------------------------------------------ validation
     def report(self) -> BodyReport:
-        """Narrow passages (warnings) and the pieces of the eroded area (error if several)."""
-        r = self.radius
-        eroded = self.eroded(r)
-        pieces = sorted((g for g in shapely.get_parts(eroded)
-                         if isinstance(g, Polygon) and g.area > _AREA_EPS),
-                        key=lambda g: -g.area)
-        opened = eroded.buffer(r, join_style="mitre")
-        lost = self.level.walkable.difference(opened)
-        narrow = []
-        for part in shapely.get_parts(lost):
-            if part.area <= _AREA_EPS:
-                continue
-            thin = part.buffer(-1e-3)
-            if thin.is_empty:  # a sliver along a wall, not a passage
-                continue
-            p = part.representative_point()
-            narrow.append((round(float(p.x), 1), round(float(p.y), 1)))
+        """Narrow passages (warnings) and the pieces of the eroded area (error if several);
+        a walkable area of many holes is checked group by group (:mod:`navmesh.body_report`).
+        Computed once per :class:`Clearance` (every command checks it, every trial too)."""
+        if self._report is None:
+            self._report = self._compute_report()
+        return self._report
+
+    def _compute_report(self) -> BodyReport:
+        from navmesh.body_report import LOCAL_MIN_HOLES, exact_parts, local_parts
+
+        r, walkable = self.radius, self.level.walkable
+        if isinstance(walkable, Polygon) and len(walkable.interiors) > LOCAL_MIN_HOLES:
+            narrow, pieces = local_parts(walkable, r)
+        else:
+            narrow, pieces = exact_parts(walkable, r)
+            pieces.sort(key=lambda g: -g.area)
         points = tuple((round(float(g.representative_point().x), 1),
                         round(float(g.representative_point().y), 1)) for g in pieces)
         return BodyReport(r, tuple(sorted(set(narrow))), tuple(g.area for g in pieces), points)
+
+
+def check_body(level: Level, radius: float, source: str | None = None) -> BodyReport:
+    """The level check every command shares (``validate``, ``sim``, ``run``, ``play``, the
+    world): a body of ``radius`` must reach the whole walkable area, else a one-line
+    :class:`~navmesh.errors.LevelError`. Returns the report (its narrow spots are warnings)."""
+    from navmesh.errors import LevelError
+
+    report = clearance_for(level, radius).report()
+    if not report.connected:
+        where = ", ".join(f"({x:.1f}, {y:.1f})" for x, y in report.piece_points[:4])
+        src = source or (level.path.name if level.path is not None else level.name)
+        raise LevelError(src, "walkable area",
+                         f"an agent of radius {radius:g} cannot reach the whole level: it is "
+                         f"in {len(report.pieces)} pieces for its body (near {where})")
+    return report
 
 
 @dataclass(frozen=True)

@@ -31,6 +31,8 @@ from navmesh.errors import LevelError
 from navmesh.files import FileRefused, read_regular
 from navmesh.level_fields import (
     MAX_CELLS,
+    MAX_EXTENT,
+    MIN_CELL_SIZE,
     MAX_FILE_BYTES,
     MAX_SPOTS,
     ZONE_KINDS,

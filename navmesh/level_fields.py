@@ -22,6 +22,13 @@ __all__ = ["MAX_CELLS", "MAX_SPOTS", "ZONE_KINDS", "register_zone_kind", "zone_k
 MAX_FILE_BYTES = 64 * 2**20
 """Largest level file read (64 MiB; the bundled levels are a few kB)."""
 
+MAX_EXTENT = 1e6
+"""Largest coordinate (and cell size) of a level, in world units; beyond, the geometry's
+double precision is lost to the agents' sub-unit moves (the bundled levels span 100)."""
+
+MIN_CELL_SIZE = 1e-3
+"""Smallest cell size, in world units (an agent's body must also fit a cell: check_level)."""
+
 MAX_CELLS = 1_000_000
 """Largest allowed occupancy grid (rows x cols); checked before anything is rasterised."""
 

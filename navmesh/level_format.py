@@ -37,6 +37,8 @@ from navmesh.grid_geometry import cells_polygon
 from navmesh.level_fields import (
     _ARRAY_TYPES,
     MAX_CELLS,
+    MAX_EXTENT,
+    MIN_CELL_SIZE,
     MAX_SPOTS,
     ZONE_KINDS,
     Point,
@@ -191,8 +193,9 @@ def parse_level(
     if not isinstance(name, str) or not name.strip():
         _fail(src, "name", f"expected a non-empty string, got {_describe(name)}")
     cell_size = _number(data.get("cell_size", 1.0), src, "cell_size")
-    if cell_size <= 0:
-        _fail(src, "cell_size", f"must be > 0, got {cell_size:g}")
+    if not MIN_CELL_SIZE <= cell_size <= MAX_EXTENT:  # beyond, geometry loses its precision
+        _fail(src, "cell_size", f"must be in [{MIN_CELL_SIZE:g}, {MAX_EXTENT:g}] world units, "
+                                f"got {cell_size:g}")
 
     has_outline, has_grid = "outline" in data, "grid" in data
     if has_outline and has_grid:
@@ -203,13 +206,17 @@ def parse_level(
         if "obstacles" in data:
             _fail(src, "obstacles", "only allowed with 'outline', not with 'grid'")
         occupancy = _parse_grid(data["grid"], src)
-        if not math.isfinite(max(occupancy.shape) * cell_size):
-            _fail(src, "cell_size", f"{cell_size:g} is too large: the level's extent overflows")
+        if not max(occupancy.shape) * cell_size <= MAX_EXTENT:
+            _fail(src, "cell_size", f"{cell_size:g} is too large: the level would span "
+                                    f"{max(occupancy.shape) * cell_size:g} world units, more "
+                                    f"than the limit of {MAX_EXTENT:g}")
         _check_connected(occupancy, src, "grid")
         walkable = cells_polygon(occupancy, cell_size)
         outline: Polygon | None = None
     else:
         outline = _parse_polygon(data["outline"], src, "outline")
+        if not max(abs(v) for v in outline.bounds) <= MAX_EXTENT:
+            _fail(src, "outline", f"coordinates beyond ±{MAX_EXTENT:g} world units")
         walkable, occupancy = _polygon_geometry(outline, data.get("obstacles", []), cell_size, src)
 
     zones = _parse_zones(data.get("zones", {}), walkable, src)

@@ -1,0 +1,82 @@
+"""Scale of the body-clearance check on hostile levels (issue 24, class 4).
+
+Writes the levels of the issue into a temporary folder — a 1000 × 1000 grid of pillars
+(250,000 holes), an outline of 10^5 vertices, a 10^5-vertex obstacle, and 10^5 outline
+vertices with 10^4 obstacles — and times ``stealth validate`` (and, with ``--levels``,
+``stealth levels``) on each in a subprocess with a timeout. Acceptance: validate on the
+pillars within 20 s, the others within 30 s or one error line.
+
+Run: ``python benchmarks/hostile_scale.py`` (about a minute); ``--levels`` adds
+``stealth levels`` (the partition's triangulation, minutes on some of these).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import os
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import _paths
+
+ENV = {**os.environ, "PYTHONPATH": str(_paths.ROOT)}
+
+
+def levels(folder: Path) -> dict[str, Path]:
+    n, r = 100_000, 500.0
+    ring = [[r + r * math.cos(2 * math.pi * i / n), r + r * math.sin(2 * math.pi * i / n)]
+            for i in range(n)]
+    side = 1000
+    grid = ["".join("#" if y % 2 and x % 2 and 0 < y < side - 1 and 0 < x < side - 1 else "."
+                    for x in range(side)) for y in range(side)]
+    hole = [[500 + 200 * math.cos(2 * math.pi * i / n), 500 + 200 * math.sin(2 * math.pi * i / n)]
+            for i in range(n)]
+    boxes = [[[x, y], [x + 2, y], [x + 2, y + 2], [x, y + 2]]
+             for x in range(200, 800, 6) for y in range(200, 800, 6)][:10_000]
+    docs = {
+        "pillars1000": {"grid": grid, "guards": [[0.5, 0.5]]},
+        "outline1e5": {"cell_size": 10.0, "outline": ring, "guards": [[500, 500]]},
+        "obstacle1e5": {"cell_size": 10.0, "outline": [[0, 0], [1000, 0], [1000, 1000], [0, 1000]],
+                        "obstacles": [hole], "guards": [[50, 50]]},
+        "outline1e5_obstacles1e4": {"cell_size": 2.0, "outline": ring, "obstacles": boxes,
+                                    "guards": [[500, 150]]},
+    }
+    paths = {}
+    for name, doc in docs.items():
+        path = folder / f"{name}.json"
+        path.write_text(json.dumps({"format": "stealth-level/1", "name": name, **doc}))
+        paths[name] = path
+    return paths
+
+
+def timed(args: list[str], timeout: float) -> tuple[float, str]:
+    start = time.perf_counter()
+    try:
+        done = subprocess.run([sys.executable, "-m", "headless.cli", *args], env=ENV,
+                              capture_output=True, text=True, timeout=timeout)
+    except subprocess.TimeoutExpired:
+        return time.perf_counter() - start, f"timeout after {timeout:g} s"
+    last = (done.stderr.strip().splitlines() or [""])[-1]
+    return time.perf_counter() - start, f"exit {done.returncode}: {last[:120]}"
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--levels", action="store_true", help="time `stealth levels` too")
+    parser.add_argument("--timeout", type=float, default=120.0)
+    args = parser.parse_args()
+    commands = ["validate", "levels"] if args.levels else ["validate"]
+    with tempfile.TemporaryDirectory() as folder:
+        for name, path in levels(Path(folder)).items():
+            for command in commands:
+                seconds, outcome = timed([command, str(path)], args.timeout)
+                print(f"{command:9s} {name:26s} {seconds:7.1f} s  {outcome}", flush=True)
+
+
+if __name__ == "__main__":
+    main()
