@@ -11,24 +11,16 @@ stderr. The heavy commands live in their own modules and are imported only when 
 from __future__ import annotations
 
 import argparse
-import errno
-import io
 import json
-import os
-import sqlite3
 import sys
-import traceback
 from collections.abc import Mapping, Sequence
 from pathlib import Path
-from typing import Any, NoReturn
-
-from ai import GUARD_MODES, PLAYER_POLICIES
-from navmesh.errors import StealthError
-from navmesh.graph import ABSTRACTIONS
+from typing import Any
 
 from .errors import UserError
+from .failure import EXIT_USER_ERROR, GuardedParser, UsageError, guarded, os_error_line, wants_debug
 
-EXIT_USER_ERROR = 2
+__all__ = ["EXIT_USER_ERROR", "UsageError", "build_parser", "main", "os_error_line"]
 
 
 def _point(text: str) -> tuple[float, float]:
@@ -320,15 +312,7 @@ def _cmd_tune(args: argparse.Namespace) -> int:
 
 
 # ---------------------------------------------------------------------- parser
-class UsageError(UserError):
-    """A command line argparse rejects (unknown option, bad choice, missing argument)."""
-
-
-class _Parser(argparse.ArgumentParser):
-    """An argparse parser whose errors are one ``stealth: error: ...`` line (exit 2)."""
-
-    def error(self, message: str) -> NoReturn:
-        raise UsageError(message)
+_Parser = GuardedParser
 
 
 class _Help(argparse.ArgumentDefaultsHelpFormatter, argparse.RawDescriptionHelpFormatter):
@@ -355,6 +339,8 @@ def _version() -> str:
 
 def build_parser() -> argparse.ArgumentParser:
     """The ``stealth`` parser; its choices come from the registries and name constants."""
+    from ai import GUARD_MODES, PLAYER_POLICIES
+    from navmesh.graph import ABSTRACTIONS
     from game.front.keys import key_table
     from game.scene import OVERLAYS
     from game.world import SCENARIOS
@@ -541,69 +527,18 @@ def build_parser() -> argparse.ArgumentParser:
 def main(argv: Sequence[str] | None = None) -> int:
     """Run one ``stealth`` command; returns its exit code (2 for any user error).
 
-    The one place where failures become one line: a :class:`StealthError` (a user's
-    mistake), an :class:`OSError` (disk full, read-only or missing directory, a directory
-    where a file should be, a closed pipe: :func:`os_error_line` names the file and the
-    errno) or a results store SQLite cannot write. ``--debug`` anywhere before ``--`` also
+    Failures become one line in :func:`headless.failure.guarded` (a user's mistake, an
+    OSError naming its file, a file that is not a results store, Ctrl-C — also during the
+    imports of start-up, which happen inside it). ``--debug`` anywhere before ``--`` also
     prints the traceback.
     """
     words = list(sys.argv[1:] if argv is None else argv)
-    debug = "--debug" in words[:words.index("--")] if "--" in words else "--debug" in words
-    _tolerant_streams()
-    try:
+
+    def body() -> int:
         args = build_parser().parse_args(words)
         return int(args.func(args))
-    except StealthError as error:
-        return _fail(str(error), debug)
-    except BrokenPipeError:
-        _detach_stdout()  # the reader is gone: nothing more can reach it
-        return _fail("stdout: the reading end of the pipe was closed (EPIPE)", debug)
-    except OSError as error:
-        return _fail(os_error_line(error), debug)
-    except sqlite3.DatabaseError as error:
-        return _fail(f"results store: {error}", debug)
-    except KeyboardInterrupt:
-        print("stealth: interrupted", file=sys.stderr)
-        return 130
 
-
-def os_error_line(error: OSError) -> str:
-    """``FILE: what happened (ERRNO)`` for an OSError, e.g. ``/dev/full: No space left on
-    device (ENOSPC)``.
-
-    >>> os_error_line(IsADirectoryError(21, "Is a directory", "out/table.md"))
-    'out/table.md: Is a directory (EISDIR)'
-    """
-    code = errno.errorcode.get(error.errno or 0)
-    text = error.strerror or str(error) or type(error).__name__
-    names = [str(f) for f in (error.filename, error.filename2) if f is not None]
-    return (f"{' -> '.join(names)}: " if names else "") + text + (f" ({code})" if code else "")
-
-
-def _fail(message: str, debug: bool) -> int:
-    """Print the one ``stealth: error:`` line (after the traceback with ``--debug``)."""
-    if debug:
-        traceback.print_exc(file=sys.stderr)
-    print(f"stealth: error: {' '.join(message.split())}", file=sys.stderr)
-    return EXIT_USER_ERROR
-
-
-def _tolerant_streams() -> None:
-    """Under an ASCII locale a level or file name that ASCII cannot spell is printed with
-    backslash escapes instead of ending the command with a UnicodeEncodeError."""
-    for stream in (sys.stdout, sys.stderr):
-        if isinstance(stream, io.TextIOWrapper):
-            stream.reconfigure(errors="backslashreplace")
-
-
-def _detach_stdout() -> None:
-    """Point stdout at /dev/null, so the interpreter's final flush cannot fail again."""
-    try:
-        devnull = os.open(os.devnull, os.O_WRONLY)
-        os.dup2(devnull, sys.stdout.fileno())
-        os.close(devnull)
-    except (OSError, ValueError):
-        pass
+    return guarded(body, wants_debug(words))
 
 
 if __name__ == "__main__":

@@ -22,6 +22,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+from .failure import GuardedParser, guarded, wants_debug
 from .beside_paper import COLUMNS
 from .errors import UserError
 from .markers import replace_marked
@@ -97,6 +98,8 @@ def _target_for(trials: Sequence[Mapping[str, Any]], name: str) -> Target:
 
 
 def _share(rows: Sequence[Compared]) -> str:
+    if not rows:  # e.g. a capture-rate column of a store without capture-scenario cells
+        return "– (no cells)"
     within = sum(r.within for r in rows)
     return f"{within}/{len(rows)} ({within / len(rows):.0%})"
 
@@ -104,7 +107,7 @@ def _share(rows: Sequence[Compared]) -> str:
 def distance(rows: Sequence[Compared]) -> float:
     """The tune objective of these cells (:meth:`headless.objective.Target.distance`)."""
     scaled = [r.scaled if math.isfinite(r.scaled) else 10.0 for r in rows]
-    return sum(e * e for e in scaled) / len(scaled)
+    return sum(e * e for e in scaled) / len(scaled) if scaled else math.nan
 
 
 def held_out_markdown(ours: Sequence[Compared], seeds: str,
@@ -201,7 +204,14 @@ def plot_errors(ours: Sequence[Compared], path: Path, title: str) -> None:
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(prog="python -m headless.held_out",
+    """``python -m headless.held_out``: its exit code; every failure one ``stealth: error:`` line
+    (:func:`headless.failure.guarded`, as for ``stealth``)."""
+    words = list(sys.argv[1:] if argv is None else argv)
+    return guarded(lambda: _main(words), wants_debug(words))
+
+
+def _main(argv: Sequence[str]) -> int:
+    parser = GuardedParser(prog="python -m headless.held_out",
                                      description=__doc__.split("\n\n")[0])
     parser.add_argument("dir", type=Path, help="a results directory (results.sqlite)")
     parser.add_argument("--seeds-from", type=int, default=0, metavar="K",
@@ -220,6 +230,9 @@ def main(argv: Sequence[str] | None = None) -> int:
         trials = held_out_trials(args.dir, args.seeds_from)
         target = _target_for(trials, args.target)
         ours = compare(trials, target)
+        if not ours:
+            raise UserError(f"{args.dir}: no cell of the target {args.target!r} has trials of "
+                            "these abstractions, guard modes and player policies")
         baseline = None
         seeds = sorted({int(t["seed"]) for t in trials})
         if args.baseline is not None:  # on exactly our seeds (a store still running has fewer)

@@ -29,6 +29,7 @@ from typing import Any
 
 import numpy as np
 
+from .failure import GuardedParser, guarded, wants_debug
 from .errors import UserError
 from .markers import replace_marked
 from .factor_report import numeric_factors
@@ -307,7 +308,14 @@ def write_between_markers(path: Path, text: str) -> None:
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(prog="python -m headless.robustness",
+    """``python -m headless.robustness``: its exit code; every failure one ``stealth: error:`` line
+    (:func:`headless.failure.guarded`, as for ``stealth``)."""
+    words = list(sys.argv[1:] if argv is None else argv)
+    return guarded(lambda: _main(words), wants_debug(words))
+
+
+def _main(argv: Sequence[str]) -> int:
+    parser = GuardedParser(prog="python -m headless.robustness",
                                      description=(__doc__ or "").split("\n\n")[0])
     parser.add_argument("store", type=Path, help="results directory of a two-factor design")
     parser.add_argument("--write", type=Path, default=None,
