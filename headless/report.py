@@ -33,8 +33,9 @@ import csv
 import json
 import sys
 from pathlib import Path
+from typing import Any
 
-from ai.stimuli import load_stimulus
+from navmesh.level import register_zone_kind
 
 from .errors import UserError
 from .factor_report import write_factor_report
@@ -90,9 +91,8 @@ def write_report(directory: str | Path, *, figures: bool = True,
         raise UserError(f"{store_path}: no finished trials yet"
                         + (f" ({len(failures)} failed)" if failures else ""))
 
-    design = json.loads(meta.get("design", "{}"))
-    for plugin in design.get("stimuli", []):  # their zone kinds, before the levels are read
-        load_stimulus(plugin)
+    design = _design(meta, store_path)
+    _register_stored_zone_kinds(meta, design, store_path)
     written: list[Path] = []
     path = directory / "trials.csv"
     write_trials_csv(trials, path)
@@ -131,6 +131,42 @@ def write_report(directory: str | Path, *, figures: bool = True,
                            written + [path]), encoding="utf-8")
     written.append(path)
     return written
+
+
+def _design(meta: dict[str, str], store_path: Path) -> dict[str, Any]:
+    """The store's design (``meta.design``): a JSON object, or one line naming the store."""
+    try:
+        design = json.loads(meta.get("design", "{}"))
+    except ValueError:
+        raise UserError(f"{store_path}: meta.design is not JSON") from None
+    if not isinstance(design, dict):
+        raise UserError(f"{store_path}: meta.design is {type(design).__name__}, not an object")
+    return design
+
+
+def _register_stored_zone_kinds(meta: dict[str, str], design: dict[str, Any],
+                                store_path: Path) -> None:
+    """Let the levels use the zone kinds the sweep stored (``meta.zone_kinds``, data).
+
+    A report never imports the plugins a store names: a results folder shared with a
+    ``.py`` inside must not run it. A store written before the kinds were stored reports
+    without them (a level using a plugin's zone kind then has no heatmap), after one note.
+    """
+    stored = meta.get("zone_kinds")
+    if stored is None:
+        if design.get("stimuli"):
+            print(f"stealth: note: {store_path} predates stored zone kinds; its plugins are "
+                  "not imported, so levels with their zones get no heatmap", file=sys.stderr)
+        return
+    try:
+        kinds = json.loads(stored)
+        if not isinstance(kinds, list):
+            raise ValueError(f"a {type(kinds).__name__}")
+        for kind in kinds:
+            register_zone_kind(kind)
+    except ValueError as error:
+        raise UserError(f"{store_path}: meta.zone_kinds is not a list of zone kinds ({error})"
+                        ) from None
 
 
 def cmd_report(args: argparse.Namespace) -> int:
