@@ -17,6 +17,7 @@ from collections.abc import Mapping, Sequence
 from pathlib import Path
 
 from .failure import GuardedParser, guarded, wants_debug
+from .clobber import refuse_inputs_all
 from .markers import replace_marked
 from .paper import paper_table3
 
@@ -92,6 +93,10 @@ def _main(argv: Sequence[str]) -> int:
     parser.add_argument("--write", type=Path, default=None,
                         help="replace the marked part of this Markdown file instead of printing")
     args = parser.parse_args(argv)
+    if args.write is not None:
+        refuse_inputs_all("--write", [args.write], [args.dir / n for n in ("table.csv", "table.md")]
+                          + ([args.literal / "table.csv", args.literal / "table.md"]
+                             if args.literal else []))
     text = beside_paper(args.dir, args.literal)
     if args.write is None:
         sys.stdout.write(text)

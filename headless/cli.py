@@ -213,14 +213,10 @@ def cmd_sim(args: argparse.Namespace) -> int:
     if args.trace:
         from navmesh.level import resolve_level_path
 
-        from .clobber import refuse_inputs
+        from .clobber import open_output, plugin_files
 
-        plugins = [p.rpartition(":")[0] for p in args.stimulus if ":" in p]
-        refuse_inputs("--trace", args.trace, [resolve_level_path(args.level), *plugins])
-        try:
-            handle = open(args.trace, "w", encoding="utf-8")
-        except OSError as error:
-            raise UserError(f"--trace {args.trace}: cannot write ({error.strerror})") from None
+        handle = open_output("--trace", args.trace, [resolve_level_path(args.level), args.config,
+                                                     *plugin_files(args.stimulus)])
         try:
             with handle:
                 row = run_trial(spec, trace=handle, explain=args.explain)
@@ -279,6 +275,11 @@ def _cmd_play(args: argparse.Namespace) -> int:
     from game.config_file import read_config_file
     from game.front.play import cmd_play
 
+    from .clobber import level_file, plugin_files, refuse_inputs_all
+
+    inputs = [level_file(args.level), args.config, *plugin_files(args.stimulus)]
+    refuse_inputs_all("--screenshot/--record", [p for p in (args.screenshot, args.record) if p],
+                      inputs)
     if args.config:  # the file's overrides first, so --set still wins
         args.set = [f"{k}={v}" for k, v in read_config_file(args.config).items()] + args.set
     if args.record is None:
@@ -294,6 +295,12 @@ def _cmd_play(args: argparse.Namespace) -> int:
 def _cmd_replay(args: argparse.Namespace) -> int:
     from game.front.replay import cmd_replay, replay_trial
 
+    from .clobber import level_file, refuse_inputs
+    from .store import STORE_NAME
+
+    if args.screenshot:
+        refuse_inputs("--screenshot", args.screenshot, [
+            args.trace, Path(args.trace) / STORE_NAME, level_file(args.level)])
     if args.trial is not None:
         from .reproduce import stored_spec, stored_trial
         from .sessions import session_trace

@@ -108,7 +108,7 @@ def _evaluate(node: ast.expr, lookup: Lookup | None, text: str) -> float:
     """The value of ``node`` (a checked tree); ``lookup=None`` for a constant-only part."""
     if isinstance(node, ast.Constant):
         try:
-            return float(node.value)
+            return float(node.value)  # type: ignore[arg-type]  # checked: int or float
         except OverflowError:
             raise ExpressionError(f"expression {text!r}: the constant {str(node.value)[:20]}… "
                                   "is too large for a float") from None

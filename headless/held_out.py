@@ -24,6 +24,7 @@ from typing import Any
 
 from .failure import GuardedParser, guarded, wants_debug
 from .beside_paper import COLUMNS
+from .clobber import refuse_inputs_all
 from .errors import UserError
 from .markers import replace_marked
 from .objective import Cell, Target, aggregate, load_target
@@ -227,6 +228,8 @@ def _main(argv: Sequence[str]) -> int:
     try:
         if args.seeds_from < 0:
             raise UserError(f"--seeds-from: must be at least 0, got {args.seeds_from}")
+        refuse_inputs_all("--figure/--write", [p for p in (args.figure, args.write) if p],
+                          [args.dir / "results.sqlite", args.baseline and args.baseline / "results.sqlite"])
         trials = held_out_trials(args.dir, args.seeds_from)
         target = _target_for(trials, args.target)
         ours = compare(trials, target)

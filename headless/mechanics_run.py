@@ -22,6 +22,8 @@ import numpy as np
 
 from navmesh.level import load_level
 
+from .clobber import level_file, refuse_inputs_all
+from .errors import UserError
 from .mechanics import BOOTSTRAP, DRAW_DISTANCES, EXPECTED, MECHANICS, Row, run_job
 from .executors import check_workers, process_pool
 from .filenames import output_path
@@ -233,11 +235,17 @@ def write_results(out: Path, rows: Sequence[Row], summaries: Sequence[Summary], 
         writer.writerows(rows)
 
 
+MAX_SEEDS = 10_000
+"""Most paired seeds per mechanic ``stealth mechanics --seeds`` runs (30 by default)."""
+
+
 def cmd_mechanics(args: argparse.Namespace) -> int:
     """``stealth mechanics``: run the paired experiment, write the files, print the table."""
     if args.seeds < 2:
         print("stealth: error: --seeds: need at least 2 seeds", file=sys.stderr)
         return 2
+    if args.seeds > MAX_SEEDS:
+        raise UserError(f"--seeds: at most {MAX_SEEDS} paired seeds per mechanic, got {args.seeds}")
     if args.workers is not None:
         check_workers(args.workers)
     if args.stimulus:
@@ -249,6 +257,10 @@ def cmd_mechanics(args: argparse.Namespace) -> int:
     except ValueError as error:
         print(f"stealth: error: {error}", file=sys.stderr)
         return 2
+    refuse_inputs_all("--out", [output_path(Path(args.out), *name, suffix=suffix) for name, suffix
+                                in ((("mechanics",), ".md"), (("mechanics",), ".csv"),
+                                    (("mechanics", "trials"), ".csv"))],
+                      [level_file(args.level)])
     Path(args.out).mkdir(parents=True, exist_ok=True)  # an OSError now, not after the trials
     rows, seconds = run_mechanics(args.seeds, args.level, args.abstraction, args.workers)
     table = markdown(summarise(rows), draw_curve(rows), level.name, args.abstraction,

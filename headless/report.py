@@ -37,6 +37,7 @@ from typing import Any
 
 from navmesh.level import register_zone_kind
 
+from .clobber import plugin_files, refuse_inputs_all
 from .errors import UserError
 from .factor_report import write_factor_report
 from .figures import FORMATS, write_aggregate
@@ -93,6 +94,8 @@ def write_report(directory: str | Path, *, figures: bool = True,
 
     design = _design(meta, store_path)
     _register_stored_zone_kinds(meta, design, store_path)
+    refuse_inputs_all("report", [directory / name for name in _FIXED_OUTPUTS],
+                      [*{t.get("level") for t in trials}, *_plugin_files(design)])
     written: list[Path] = []
     path = directory / "trials.csv"
     write_trials_csv(trials, path)
@@ -131,6 +134,15 @@ def write_report(directory: str | Path, *, figures: bool = True,
                            written + [path]), encoding="utf-8")
     written.append(path)
     return written
+
+
+_FIXED_OUTPUTS = ("trials.csv", "table.md", "table.csv", "failed.csv", "README.md",
+                  "factors.md", "factors.csv", "sessions.md", "sessions.csv")
+
+
+def _plugin_files(design: dict[str, Any]) -> list[str]:
+    stimuli = design.get("stimuli", [])
+    return plugin_files(s for s in stimuli if isinstance(s, str)) if isinstance(stimuli, list) else []
 
 
 def _design(meta: dict[str, str], store_path: Path) -> dict[str, Any]:

@@ -30,6 +30,7 @@ from typing import Any
 import numpy as np
 
 from .failure import GuardedParser, guarded, wants_debug
+from .clobber import refuse_inputs_all
 from .errors import UserError
 from .markers import replace_marked
 from .factor_report import numeric_factors
@@ -323,6 +324,8 @@ def _main(argv: Sequence[str]) -> int:
     parser.add_argument("--figure", type=Path, default=None, help="PNG of the verdicts")
     args = parser.parse_args(argv)
     try:
+        refuse_inputs_all("--figure/--write", [p for p in (args.figure, args.write) if p],
+                          [args.store / STORE_NAME])
         if not (args.store / STORE_NAME).is_file():
             raise UserError(f"{args.store}: no {STORE_NAME} here")
         with ResultStore(args.store / STORE_NAME, readonly=True) as store:

@@ -371,6 +371,11 @@ def cmd_tune(args: argparse.Namespace) -> int:
         raise UserError(f"--trials: must be at least 1, got {args.trials}")
     if args.workers is not None and args.workers < 1:
         raise UserError(f"--workers: must be at least 1, got {args.workers}")
+    from .clobber import refuse_inputs_all
+
+    refuse_inputs_all("--out", [Path(args.out) / name for name in (
+        "best.toml", "study.csv", "report.md", "history.png", "params.png", "results.lock")],
+                      [args.spec, args.config])
     extra = read_config_file(args.config) if args.config else None
     spec = load_tune_spec(args.spec, extra)
     out = Path(args.out)
