@@ -22,6 +22,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+from .reproducible import save_figure
 from .failure import GuardedParser, guarded, wants_debug
 from .beside_paper import COLUMNS
 from .clobber import refuse_inputs_all
@@ -201,7 +202,7 @@ def plot_errors(ours: Sequence[Compared], path: Path, title: str) -> None:
         fig.colorbar(image, ax=ax, shrink=0.9)
     fig.suptitle(title, fontsize=10)
     fig.tight_layout()
-    fig.savefig(path)
+    save_figure(fig, path)
 
 
 def main(argv: Sequence[str] | None = None) -> int:

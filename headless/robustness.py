@@ -29,6 +29,7 @@ from typing import Any
 
 import numpy as np
 
+from .reproducible import save_figure
 from .failure import GuardedParser, guarded, wants_debug
 from .clobber import refuse_inputs_all
 from .errors import UserError
@@ -254,7 +255,7 @@ def draw(judgements: Sequence[Judgement], path: Path, axes: Axes) -> None:
     fig.suptitle("The paper's claims per factor cell. In each cell the deciding comparison "
                  "A−B:\nmean paired difference [95 % bootstrap CI]", fontsize=9)
     fig.tight_layout(rect=(0, 0.03, 1, 0.98))
-    fig.savefig(path)
+    save_figure(fig, path)
 
 
 def _rect(i: int, k: int, colour: str) -> Any:
