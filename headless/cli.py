@@ -10,14 +10,27 @@ stderr. The heavy commands live in their own modules and are imported only when 
 
 from __future__ import annotations
 
-import argparse
-import json
+import os
+import signal
 import sys
-from collections.abc import Mapping, Sequence
-from pathlib import Path
-from typing import Any
 
-from .errors import UserError
+
+def _quiet_interrupt(signum: int, frame: object) -> None:
+    """Ctrl-C while ``stealth`` is still importing: one line and exit 130, no traceback."""
+    os.write(2, b"stealth: interrupted\n")
+    os._exit(130)
+
+
+if __name__ == "__main__" or os.path.basename(sys.argv[0]) == "stealth":  # not as a library
+    signal.signal(signal.SIGINT, _quiet_interrupt)
+
+import argparse  # noqa: E402 - after the start-up handler above
+import json  # noqa: E402
+from collections.abc import Mapping, Sequence  # noqa: E402
+from pathlib import Path  # noqa: E402
+from typing import Any  # noqa: E402
+
+from .errors import UserError  # noqa: E402
 from .failure import EXIT_USER_ERROR, GuardedParser, UsageError, guarded, os_error_line, wants_debug
 
 __all__ = ["EXIT_USER_ERROR", "UsageError", "build_parser", "main", "os_error_line"]
@@ -44,7 +57,8 @@ def _seed(text: str) -> int:
             f"expected a whole number in {SEED.describe()}, got {text!r}") from None
     problem = SEED.problem(value)
     if problem is not None:
-        raise argparse.ArgumentTypeError(f"{value} {problem}")
+        shown = str(value) if len(str(value)) <= 30 else f"{str(value)[:12]}…({len(str(value))} digits)"
+        raise argparse.ArgumentTypeError(f"{shown} {problem}")
     return value
 
 
@@ -542,6 +556,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     words = list(sys.argv[1:] if argv is None else argv)
 
     def body() -> int:
+        if signal.getsignal(signal.SIGINT) is _quiet_interrupt:  # imported: Ctrl-C is ours now
+            signal.signal(signal.SIGINT, signal.default_int_handler)
         args = build_parser().parse_args(words)
         return int(args.func(args))
 
