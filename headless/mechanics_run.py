@@ -239,6 +239,24 @@ MAX_SEEDS = 10_000
 """Most paired seeds per mechanic ``stealth mechanics --seeds`` runs (30 by default)."""
 
 
+MIN_WALKABLE = 16
+"""Fewest walkable cells a level needs for the mechanics (a decoy 8 hops from the guards)."""
+
+
+def check_mechanics_level(level: Any, name: str) -> None:
+    """Refuse, before any trial, a level the built-in mechanics cannot be measured on: the
+    dark and concealment measurements place the player in such a zone, the decoy walks
+    guards to a far node."""
+    missing = [kind for kind in ("dark", "concealment") if not level.zones.get(kind)]
+    if missing:
+        raise UserError(f"--level {name}: the mechanics need a {' and a '.join(missing)} "
+                        f"zone; this level has none")
+    walkable = int(level.occupancy.sum())
+    if walkable < MIN_WALKABLE or not level.guards:
+        raise UserError(f"--level {name}: the mechanics need at least {MIN_WALKABLE} walkable "
+                        f"cells and a guard; this level has {walkable} and {len(level.guards)}")
+
+
 def cmd_mechanics(args: argparse.Namespace) -> int:
     """``stealth mechanics``: run the paired experiment, write the files, print the table."""
     if args.seeds < 2:
@@ -257,6 +275,7 @@ def cmd_mechanics(args: argparse.Namespace) -> int:
     except ValueError as error:
         print(f"stealth: error: {error}", file=sys.stderr)
         return 2
+    check_mechanics_level(level, args.level)
     refuse_inputs_all("--out", [output_path(Path(args.out), *name, suffix=suffix) for name, suffix
                                 in ((("mechanics",), ".md"), (("mechanics",), ".csv"),
                                     (("mechanics", "trials"), ".csv"))],
