@@ -52,9 +52,8 @@ def wants_debug(words: Sequence[str]) -> bool:
 def guarded(body: Callable[[], int], debug: bool = False) -> int:
     """``body()``'s exit code, or 2 after one ``stealth: error:`` line (130 on Ctrl-C).
 
-    A ``SystemExit`` whose code is not an int (argparse's ``--help`` exits 0; a plugin's
-    ``sys.exit("text")``) or that comes from anywhere is reported as what it is: the body
-    itself returns its code, so a ``SystemExit`` here was raised by code it called.
+    The body returns its code, so a ``SystemExit`` other than argparse's ``--help`` /
+    ``--version`` (code 0, passed on) was raised by code it called, and is reported.
     """
     _tolerant_streams()
     try:
@@ -71,8 +70,8 @@ def guarded(body: Callable[[], int], debug: bool = False) -> int:
     except MemoryError:
         return _fail("out of memory", debug)
     except SystemExit as exit_:
-        if exit_.code in (0, None):  # --help, --version
-            return 0
+        if exit_.code in (0, None):  # --help, --version: argparse's own exit, as it was
+            raise
         return _fail(f"code called sys.exit({exit_.code!r}) (a plugin or user file?)", debug)
     except KeyboardInterrupt:
         print("stealth: interrupted", file=sys.stderr)
