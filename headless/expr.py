@@ -60,6 +60,11 @@ _ARITY: dict[str, tuple[int, int]] = {"abs": (1, 1), "min": (2, 64), "max": (2, 
 _SYMBOL = {ast.Add: "+", ast.Sub: "-", ast.Mult: "*", ast.Div: "/", ast.Pow: "**"}
 
 
+def _short(text: str) -> str:
+    """``text`` as an error message quotes it: at most 80 characters."""
+    return text if len(text) <= 80 else text[:77] + "..."
+
+
 def _reference(node: ast.expr) -> tuple[str, tuple[str, ...]] | None:
     """``a.b.metric`` as ``("metric", ("a", "b"))``; None for anything else."""
     selectors: list[str] = []
@@ -91,15 +96,18 @@ def _arithmetic(op: type[ast.operator], left: float, right: float, text: str) ->
     try:
         value = _BINARY[op](left, right)
     except ZeroDivisionError:
-        raise ExpressionError(f"expression {text!r}: division by zero") from None
+        raise ExpressionError(f"expression {_short(text)!r}: division by zero") from None
     except OverflowError:
-        raise ExpressionError(f"expression {text!r}: overflow ({left:g} {_SYMBOL[op]} "
+        raise ExpressionError(f"expression {_short(text)!r}: overflow ({left:g} {_SYMBOL[op]} "
                               f"{right:g} is too large for a float)") from None
-    except ValueError:  # math.pow of a negative base and a fractional exponent
-        raise ExpressionError(f"expression {text!r}: {left:g} ** {right:g} has no real value "
+    except ValueError:  # math.pow: 0 to a negative power, or a negative base and a fraction
+        if left == 0:
+            raise ExpressionError(f"expression {_short(text)!r}: division by zero (0 ** {right:g})"
+                                  ) from None
+        raise ExpressionError(f"expression {_short(text)!r}: {left:g} ** {right:g} has no real value "
                               "(a complex result)") from None
     if math.isinf(value) and math.isfinite(left) and math.isfinite(right):
-        raise ExpressionError(f"expression {text!r}: overflow ({left:g} {_SYMBOL[op]} "
+        raise ExpressionError(f"expression {_short(text)!r}: overflow ({left:g} {_SYMBOL[op]} "
                               f"{right:g} is too large for a float)")
     return value
 
@@ -110,7 +118,7 @@ def _evaluate(node: ast.expr, lookup: Lookup | None, text: str) -> float:
         try:
             return float(node.value)  # type: ignore[arg-type]  # checked: int or float
         except OverflowError:
-            raise ExpressionError(f"expression {text!r}: the constant {str(node.value)[:20]}… "
+            raise ExpressionError(f"expression {_short(text)!r}: the constant {str(node.value)[:20]}… "
                                   "is too large for a float") from None
     if isinstance(node, ast.BinOp):
         return _arithmetic(type(node.op), _evaluate(node.left, lookup, text),
@@ -136,7 +144,7 @@ def _check(node: ast.expr, text: str, names: list[tuple[str, tuple[str, ...]]],
            depth: int = 0) -> None:
     """Accept only the grammar of the module docstring; collect the metric references."""
     def bad(what: str) -> UserError:
-        return UserError(f"expression {text!r}: {what} is not allowed (arithmetic over metric "
+        return UserError(f"expression {_short(text)!r}: {what} is not allowed (arithmetic over metric "
                          "names only)")
     if depth > MAX_DEPTH:
         raise UserError(f"expression {text[:40]!r}…: nested more than {MAX_DEPTH} levels deep")
@@ -159,7 +167,7 @@ def _check(node: ast.expr, text: str, names: list[tuple[str, tuple[str, ...]]],
             raise bad("a call without arguments")
         least, most = _ARITY[node.func.id]
         if not least <= len(node.args) <= most:
-            raise UserError(f"expression {text!r}: {node.func.id}() takes "
+            raise UserError(f"expression {_short(text)!r}: {node.func.id}() takes "
                             + (f"{least} argument" if least == most
                                else f"{least} to {most} arguments")
                             + f", got {len(node.args)}")
@@ -200,12 +208,12 @@ def _parse(text: str, what: str) -> ast.expr:
 def parse_expression(text: str) -> Expression:
     """Parse an objective expression (one-line :class:`UserError` when it is not one)."""
     if not isinstance(text, str) or not text.strip():
-        raise UserError(f"expression {text!r}: expected a metric expression")
+        raise UserError(f"expression {_short(text)!r}: expected a metric expression")
     tree = _parse(text, "expression")
     names: list[tuple[str, tuple[str, ...]]] = []
     _check(tree, text, names)
     if not names:
-        raise UserError(f"expression {text!r}: names no metric")
+        raise UserError(f"expression {_short(text)!r}: names no metric")
     return Expression(text, tree, tuple(dict.fromkeys(names)))
 
 
@@ -215,7 +223,7 @@ def parse_constraint(text: str) -> Expression:
     tree = _parse(text, "constraint") if isinstance(text, str) else None
     if (not isinstance(tree, ast.Compare) or len(tree.ops) != 1
             or not isinstance(tree.ops[0], (ast.LtE, ast.Lt, ast.GtE, ast.Gt))):
-        raise UserError(f"constraint {text!r}: expected one comparison, e.g. 'backtracks <= 10'")
+        raise UserError(f"constraint {_short(text)!r}: expected one comparison, e.g. 'backtracks <= 10'")
     left, right = tree.left, tree.comparators[0]
     if isinstance(tree.ops[0], (ast.GtE, ast.Gt)):
         left, right = right, left
@@ -223,5 +231,5 @@ def parse_constraint(text: str) -> Expression:
     names: list[tuple[str, tuple[str, ...]]] = []
     _check(body, text, names)
     if not names:
-        raise UserError(f"constraint {text!r}: names no metric")
+        raise UserError(f"constraint {_short(text)!r}: names no metric")
     return Expression(text, body, tuple(dict.fromkeys(names)))

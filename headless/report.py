@@ -156,6 +156,10 @@ def _design(meta: dict[str, str], store_path: Path) -> dict[str, Any]:
     return design
 
 
+MAX_ZONE_KINDS = 256
+"""Most zone kinds a store may name (a hostile store must not make the report crawl)."""
+
+
 def _register_stored_zone_kinds(meta: dict[str, str], design: dict[str, Any],
                                 store_path: Path) -> None:
     """Let the levels use the zone kinds the sweep stored (``meta.zone_kinds``, data).
@@ -174,6 +178,8 @@ def _register_stored_zone_kinds(meta: dict[str, str], design: dict[str, Any],
         kinds = json.loads(stored)
         if not isinstance(kinds, list):
             raise ValueError(f"a {type(kinds).__name__}")
+        if len(kinds) > MAX_ZONE_KINDS:
+            raise ValueError(f"{len(kinds)} kinds, more than {MAX_ZONE_KINDS}")
         for kind in kinds:
             register_zone_kind(kind)
     except ValueError as error:

@@ -59,6 +59,9 @@ def _one_error_line(stderr: str) -> str:
     ("captures + 1/0", "division by zero"),
     ("captures * (-8) ** 0.5", "complex"),
     ("max(captures)", "takes 2 to 64 arguments, got 1"),
+    ("max(" + ", ".join(["captures"] * 65) + ")", "got 65"),
+    ("abs()", "a call without arguments"),
+    ("(" * 250 + "captures" + ")" * 250, "not an expression"),
     ("abs(captures, backtracks)", "takes 1 argument, got 2"),
     ("-" * 200_000 + "captures", "longer than"),
     ("-" * 9_000 + "captures", "nested more than"),
@@ -77,6 +80,7 @@ def test_a_hostile_expression_is_refused_when_parsed(text: str, words: str) -> N
     ("(-captures) ** 0.5", "complex"),
     ("captures * 1e308 * 10", "overflow"),
     ("captures ** 1e6", "overflow"),
+    ("backtracks ** -1", "division by zero"),
 ])
 def test_arithmetic_on_metric_values_fails_in_one_line(text: str, words: str) -> None:
     with pytest.raises(ExpressionError, match=words):
