@@ -31,7 +31,7 @@ from .errors import StimulusError
 if TYPE_CHECKING:
     from .stimulus import Stimulus
 
-__all__ = ["call", "checked_layer", "checked_number", "describe"]
+__all__ = ["call", "checked_layer", "checked_number", "describe", "is_done"]
 
 T = TypeVar("T")
 
@@ -55,6 +55,23 @@ def call(stimulus: Stimulus, method: Callable[..., T], *args: Any) -> T:
     except Exception as error:
         text = " ".join(f"{type(error).__name__}: {error}".split())
         raise StimulusError(f"{describe(stimulus)}: {method.__name__}() raised {text}") from error
+
+
+def is_done(stimulus: Stimulus) -> bool:
+    """``stimulus.done`` (an attribute or a property), checked: a property that raises, or
+    a value that is not a bool (a ``done`` written as a plain method), is a StimulusError."""
+    try:
+        value = stimulus.done
+    except StimulusError:
+        raise
+    except Exception as error:
+        text = " ".join(f"{type(error).__name__}: {error}".split())
+        raise StimulusError(f"{describe(stimulus)}: done raised {text}") from error
+    if isinstance(value, (bool, np.bool_)):
+        return bool(value)
+    hint = " (a method: make it a @property or an attribute)" if callable(value) else ""
+    raise StimulusError(f"{describe(stimulus)}: done must be a bool, got "
+                        f"{type(value).__name__}{hint}")
 
 
 def checked_layer(stimulus: Stimulus, values: Any, n: int) -> np.ndarray | None:

@@ -37,6 +37,10 @@ def _load_file(path: Path) -> Any:
     except Exception as error:  # the user's file: report it in one line
         del sys.modules[name]
         raise StimulusError(f"{path}: cannot load: {type(error).__name__}: {error}") from None
+    except SystemExit as exit_:  # sys.exit() at import: the command must not end silently
+        del sys.modules[name]
+        raise StimulusError(f"{path}: cannot load: it called sys.exit({exit_.code!r}) "
+                            "while being imported") from None
     module.__stealthfield_mtime__ = mtime  # type: ignore[attr-defined]
     return module
 
@@ -54,7 +58,7 @@ def _entry_point(name: str) -> Any:
         )
     try:
         return found[0].load()
-    except Exception as error:
+    except (Exception, SystemExit) as error:
         raise StimulusError(f"{name}: cannot load entry point: {error}") from None
 
 
@@ -90,7 +94,7 @@ def load_stimulus(spec: str) -> StimulusFactory:
         raise StimulusError(f"{text}: not a Stimulus subclass or a factory function")
     try:
         probe = obj()
-    except Exception as error:
+    except (Exception, SystemExit) as error:
         raise StimulusError(
             f"{text}: cannot be created with no arguments: {type(error).__name__}: {error}"
         ) from None

@@ -140,7 +140,7 @@ class StimulusSet:
             self.handle(event)
         for stimulus in self._active:
             plugin_call.call(stimulus, stimulus.on_tick, view, dt)
-        self._active = [s for s in self._active if not s.done]
+        self._active = [s for s in self._active if not plugin_call.is_done(s)]
         self.ctx.active = tuple(self._active)
         self.refresh()
 

@@ -131,7 +131,7 @@ class FieldContext:
         stimulus's :meth:`Stimulus.affect_sound` (rain dampens it)."""
         sound = base or Sound(self.params.noise_amplitude, self.params.noise_falloff)
         for stimulus in self.active:
-            if not stimulus.done:
+            if not plugin_call.is_done(stimulus):
                 sound = plugin_call.call(stimulus, stimulus.affect_sound, sound)
                 if not isinstance(sound, Sound):
                     raise StimulusError(f"{plugin_call.describe(stimulus)}: affect_sound() "

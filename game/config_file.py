@@ -22,18 +22,34 @@ from typing import Any
 
 from game.config import Config
 from game.errors import ConfigError
+from navmesh.files import FileRefused, read_regular
+
+MAX_CONFIG_BYTES = 2**20
+"""Largest ``--config`` file read (1 MiB; a tuned best.toml is a few hundred bytes)."""
 
 __all__ = ["flatten", "read_config_file", "toml_value", "write_config_file"]
 
 
 def flatten(table: Mapping[str, Any], prefix: str = "") -> dict[str, Any]:
-    """Nested TOML tables as dotted keys: ``{"pf": {"rho": 0.9}}`` -> ``{"pf.rho": 0.9}``."""
+    """Nested TOML tables as dotted keys: ``{"pf": {"rho": 0.9}}`` -> ``{"pf.rho": 0.9}``.
+
+    A key given twice (``"pf.rho" = 0.9`` beside ``[pf] rho = 0.8``) is a ConfigError, not
+    one value silently dropped.
+
+    >>> flatten({"pf.rho": 0.9, "pf": {"rho": 0.8}})
+    Traceback (most recent call last):
+    ...
+    game.errors.ConfigError: pf.rho: given twice (as a dotted key and inside a table); keep one
+    """
     flat: dict[str, Any] = {}
     for key, value in table.items():
-        if isinstance(value, Mapping):
-            flat.update(flatten(value, f"{prefix}{key}."))
-        else:
-            flat[f"{prefix}{key}"] = value
+        inner = flatten(value, f"{prefix}{key}.") if isinstance(value, Mapping) else {
+            f"{prefix}{key}": value}
+        for name, item in inner.items():
+            if name in flat:
+                raise ConfigError(f"{name}: given twice (as a dotted key and inside a table); "
+                                  "keep one")
+            flat[name] = item
     return flat
 
 
@@ -41,15 +57,17 @@ def read_config_file(path: str | Path) -> dict[str, Any]:
     """The overrides of a ``--config`` file, sorted by key, each value checked and coerced."""
     where = f"--config {path}"
     try:
-        data = tomllib.loads(Path(path).read_text(encoding="utf-8"))
+        data = tomllib.loads(read_regular(path, MAX_CONFIG_BYTES).decode("utf-8"))
     except FileNotFoundError:
         raise ConfigError(f"{where}: no such file") from None
+    except FileRefused as refused:  # a FIFO, a device, a file too large to be a config
+        raise ConfigError(f"{where}: {refused}") from None
     except (OSError, UnicodeDecodeError) as error:
         raise ConfigError(f"{where}: cannot read ({error})") from None
     except tomllib.TOMLDecodeError as error:
         raise ConfigError(f"{where}: not valid TOML ({error})") from None
-    flat = flatten(data)
     try:
+        flat = flatten(data)
         config = Config.load(flat)
     except ConfigError as error:
         raise ConfigError(f"{where}: {error}") from None

@@ -10,26 +10,32 @@ stderr. The heavy commands live in their own modules and are imported only when 
 
 from __future__ import annotations
 
-import argparse
-import errno
-import io
-import json
 import os
-import sqlite3
+import signal
 import sys
-import traceback
-from collections.abc import Mapping, Sequence
-from pathlib import Path
-from typing import Any, NoReturn
 
-from ai import GUARD_MODES, PLAYER_POLICIES
-from navmesh.errors import StealthError
-from navmesh.graph import ABSTRACTIONS
 
-from . import warning_lines
-from .errors import UserError
+def _quiet_interrupt(signum: int, frame: object) -> None:
+    """Ctrl-C while ``stealth`` is still importing: one line and exit 130, no traceback."""
+    os.write(2, b"stealth: interrupted\n")
+    os._exit(130)
 
-EXIT_USER_ERROR = 2
+
+if __name__ == "__main__" or os.path.basename(sys.argv[0]) == "stealth":  # not as a library
+    signal.signal(signal.SIGINT, _quiet_interrupt)
+
+import argparse  # noqa: E402 - after the start-up handler above
+from collections.abc import Mapping, Sequence  # noqa: E402
+from pathlib import Path  # noqa: E402
+from typing import Any  # noqa: E402
+
+from .errors import UserError  # noqa: E402
+from .outputs import warning_lines  # noqa: E402
+from .level_commands import cmd_levels, cmd_path, cmd_validate, emit_json, level_stats  # noqa: E402
+from .failure import EXIT_USER_ERROR, GuardedParser, UsageError, guarded, os_error_line, wants_debug
+
+__all__ = ["EXIT_USER_ERROR", "UsageError", "build_parser", "cmd_levels", "cmd_path", "cmd_validate",
+           "level_stats", "main", "os_error_line"]
 
 
 def _point(text: str) -> tuple[float, float]:
@@ -53,130 +59,12 @@ def _seed(text: str) -> int:
             f"expected a whole number in {SEED.describe()}, got {text!r}") from None
     problem = SEED.problem(value)
     if problem is not None:
-        raise argparse.ArgumentTypeError(f"{value} {problem}")
+        shown = str(value) if len(str(value)) <= 30 else f"{str(value)[:12]}…({len(str(value))} digits)"
+        raise argparse.ArgumentTypeError(f"{shown} {problem}")
     return value
 
 
-def _emit_json(document: Any) -> None:
-    json.dump(document, sys.stdout, indent=2)
-    sys.stdout.write("\n")
-
-
-# ---------------------------------------------------------------------- levels / validate
-def _navmesh(level: Any) -> Any:
-    """The level's navmesh (the partition graph's, cached per process)."""
-    from navmesh.graph import graph_for
-
-    mesh = graph_for(level, "partition").mesh
-    if mesh is None:  # pragma: no cover - a partition graph always has its mesh
-        raise RuntimeError(f"level {level.name}: the partition graph has no navmesh")
-    return mesh
-
-
-def level_stats(level: Any) -> dict[str, Any]:
-    """Paper Table 1 for one level: navmesh triangles and areas, grid size and counts."""
-    mesh = _navmesh(level)
-    walkable = int(level.occupancy.sum())
-    return {
-        "name": level.name,
-        "triangles": int(len(mesh.triangles)),
-        "min_area": round(float(mesh.areas.min()), 4),
-        "max_area": round(float(mesh.areas.max()), 4),
-        "avg_area": round(float(mesh.areas.mean()), 4),
-        "rows": level.rows,
-        "cols": level.cols,
-        "walkable": walkable,
-        "blocked": int(level.occupancy.size - walkable),
-    }
-
-
-def cmd_levels(args: argparse.Namespace) -> int:
-    from navmesh.level import bundled_level_names, load_level
-
-    from navmesh.sizing import check_fits
-
-    names = args.level or bundled_level_names()
-    levels = [load_level(name) for name in names]
-    for name, level in zip(names, levels, strict=True):
-        check_fits(level, str(name))  # refuse before building what cannot fit
-    rows = [level_stats(level) for level in levels]
-    if args.json:
-        _emit_json(rows)
-        return 0
-    header = f"{'level':<12}{'tris':>6}{'min area':>10}{'max area':>10}{'avg area':>10}" \
-             f"{'rows':>6}{'cols':>6}{'walkable':>10}{'blocked':>9}"
-    print(header)
-    for r in rows:
-        total = r["walkable"] + r["blocked"]
-        print(
-            f"{r['name']:<12}{r['triangles']:>6}{r['min_area']:>10.4f}{r['max_area']:>10.4f}"
-            f"{r['avg_area']:>10.4f}{r['rows']:>6}{r['cols']:>6}"
-            f"{r['walkable']:>5} ({100 * r['walkable'] / total:2.0f}%)"
-            f"{r['blocked']:>4} ({100 * r['blocked'] / total:2.0f}%)"
-        )
-    return 0
-
-
-def cmd_validate(args: argparse.Namespace) -> int:
-    from navmesh.errors import LevelError
-    from navmesh.sizing import check_fits
-    from navmesh.level import load_level
-
-    from ai.stimuli import load_stimulus
-
-    for plugin in args.stimulus:  # its zone kinds, before the levels that use them
-        load_stimulus(plugin)
-    failed = 0
-    for name in args.level:
-        try:
-            level = load_level(name)
-            check_fits(level, str(name))
-        except LevelError as error:
-            print(f"stealth: error: {error}", file=sys.stderr)
-            failed += 1
-        else:
-            if not _body_fits(name, level):
-                failed += 1
-                continue
-            print(f"{name}: ok ({level.name}, {level.rows}x{level.cols}, "
-                  f"{int(level.occupancy.sum())} walkable cells)", file=sys.stderr)
-    return EXIT_USER_ERROR if failed else 0
-
-
-def _body_fits(name: str, level: Any) -> bool:
-    """Warn of passages narrower than an agent (``world.agent_radius``); False, after one
-    error line, when the walkable area is disconnected for its body (the check every
-    command shares: :func:`navmesh.clearance.check_body`)."""
-    from game.config import Config
-    from navmesh.clearance import check_body
-    from navmesh.errors import LevelError
-
-    radius = float(Config.defaults()["world.agent_radius"])
-    src = Path(name).name if Path(name).suffix else name
-    try:
-        report = check_body(level, radius, src)
-    except LevelError as error:
-        print(f"stealth: error: {error}", file=sys.stderr)
-        return False
-    for x, y in report.narrow:
-        print(f"{src}: warning: passage narrower than {2 * radius:g} units near ({x:.1f}, {y:.1f})",
-              file=sys.stderr)
-    return True
-
-
-# ---------------------------------------------------------------------- path
-def cmd_path(args: argparse.Namespace) -> int:
-    from navmesh.level import load_level
-
-    path = _navmesh(load_level(args.level)).find_path(args.from_, args.to)
-    points = [[float(x), float(y)] for x, y in path.points]
-    if args.json:
-        _emit_json({"points": points, "length": float(path.length)})
-    else:
-        print(f"length {float(path.length):.4f} through {len(points)} points")
-        for x, y in points:
-            print(f"  {x:.4f},{y:.4f}")
-    return 0
+_emit_json = emit_json
 
 
 # ---------------------------------------------------------------------- sim
@@ -222,14 +110,10 @@ def cmd_sim(args: argparse.Namespace) -> int:
     if args.trace:
         from navmesh.level import resolve_level_path
 
-        from .outputs.clobber import refuse_inputs
+        from .outputs.clobber import open_output, plugin_files
 
-        plugins = [p.rpartition(":")[0] for p in args.stimulus if ":" in p]
-        refuse_inputs("--trace", args.trace, [resolve_level_path(args.level), *plugins])
-        try:
-            handle = open(args.trace, "w", encoding="utf-8")
-        except OSError as error:
-            raise UserError(f"--trace {args.trace}: cannot write ({error.strerror})") from None
+        handle = open_output("--trace", args.trace, [resolve_level_path(args.level), args.config,
+                                                     *plugin_files(args.stimulus)])
         try:
             with handle:
                 row = run_trial(spec, trace=handle, explain=args.explain)
@@ -292,6 +176,11 @@ def _cmd_play(args: argparse.Namespace) -> int:
     from game.config_file import read_config_file
     from game.front.play import cmd_play
 
+    from .outputs.clobber import level_file, plugin_files, refuse_inputs_all
+
+    inputs = [level_file(args.level), args.config, *plugin_files(args.stimulus)]
+    refuse_inputs_all("--screenshot/--record", [p for p in (args.screenshot, args.record) if p],
+                      inputs)
     if args.config:  # the file's overrides first, so --set still wins
         args.set = [f"{k}={v}" for k, v in read_config_file(args.config).items()] + args.set
     if args.record is None:
@@ -307,6 +196,12 @@ def _cmd_play(args: argparse.Namespace) -> int:
 def _cmd_replay(args: argparse.Namespace) -> int:
     from game.front.replay import cmd_replay, replay_trial
 
+    from .outputs.clobber import level_file, refuse_inputs
+    from .store import STORE_NAME
+
+    if args.screenshot:
+        refuse_inputs("--screenshot", args.screenshot, [
+            args.trace, Path(args.trace) / STORE_NAME, level_file(args.level)])
     if args.trial is not None:
         from .reproduce import stored_spec, stored_trial
         from .sessions.record import session_trace
@@ -325,15 +220,7 @@ def _cmd_tune(args: argparse.Namespace) -> int:
 
 
 # ---------------------------------------------------------------------- parser
-class UsageError(UserError):
-    """A command line argparse rejects (unknown option, bad choice, missing argument)."""
-
-
-class _Parser(argparse.ArgumentParser):
-    """An argparse parser whose errors are one ``stealth: error: ...`` line (exit 2)."""
-
-    def error(self, message: str) -> NoReturn:
-        raise UsageError(message)
+_Parser = GuardedParser
 
 
 class _Help(argparse.ArgumentDefaultsHelpFormatter, argparse.RawDescriptionHelpFormatter):
@@ -360,6 +247,8 @@ def _version() -> str:
 
 def build_parser() -> argparse.ArgumentParser:
     """The ``stealth`` parser; its choices come from the registries and name constants."""
+    from ai import GUARD_MODES, PLAYER_POLICIES
+    from navmesh.graph import ABSTRACTIONS
     from game.front.keys import key_table
     from game.scene import OVERLAYS
     from game.world import SCENARIOS
@@ -548,70 +437,21 @@ def build_parser() -> argparse.ArgumentParser:
 def main(argv: Sequence[str] | None = None) -> int:
     """Run one ``stealth`` command; returns its exit code (2 for any user error).
 
-    The one place where failures become one line: a :class:`StealthError` (a user's
-    mistake), an :class:`OSError` (disk full, read-only or missing directory, a directory
-    where a file should be, a closed pipe: :func:`os_error_line` names the file and the
-    errno) or a results store SQLite cannot write. ``--debug`` anywhere before ``--`` also
+    Failures become one line in :func:`headless.failure.guarded` (a user's mistake, an
+    OSError naming its file, a file that is not a results store, Ctrl-C — also during the
+    imports of start-up, which happen inside it). ``--debug`` anywhere before ``--`` also
     prints the traceback.
     """
     words = list(sys.argv[1:] if argv is None else argv)
-    debug = "--debug" in words[:words.index("--")] if "--" in words else "--debug" in words
-    _tolerant_streams()
     warning_lines.install()
-    try:
+
+    def body() -> int:
+        if signal.getsignal(signal.SIGINT) is _quiet_interrupt:  # imported: Ctrl-C is ours now
+            signal.signal(signal.SIGINT, signal.default_int_handler)
         args = build_parser().parse_args(words)
         return int(args.func(args))
-    except StealthError as error:
-        return _fail(str(error), debug)
-    except BrokenPipeError:
-        _detach_stdout()  # the reader is gone: nothing more can reach it
-        return _fail("stdout: the reading end of the pipe was closed (EPIPE)", debug)
-    except OSError as error:
-        return _fail(os_error_line(error), debug)
-    except sqlite3.DatabaseError as error:
-        return _fail(f"results store: {error}", debug)
-    except KeyboardInterrupt:
-        print("stealth: interrupted", file=sys.stderr)
-        return 130
 
-
-def os_error_line(error: OSError) -> str:
-    """``FILE: what happened (ERRNO)`` for an OSError, e.g. ``/dev/full: No space left on
-    device (ENOSPC)``.
-
-    >>> os_error_line(IsADirectoryError(21, "Is a directory", "out/table.md"))
-    'out/table.md: Is a directory (EISDIR)'
-    """
-    code = errno.errorcode.get(error.errno or 0)
-    text = error.strerror or str(error) or type(error).__name__
-    names = [str(f) for f in (error.filename, error.filename2) if f is not None]
-    return (f"{' -> '.join(names)}: " if names else "") + text + (f" ({code})" if code else "")
-
-
-def _fail(message: str, debug: bool) -> int:
-    """Print the one ``stealth: error:`` line (after the traceback with ``--debug``)."""
-    if debug:
-        traceback.print_exc(file=sys.stderr)
-    print(f"stealth: error: {' '.join(message.split())}", file=sys.stderr)
-    return EXIT_USER_ERROR
-
-
-def _tolerant_streams() -> None:
-    """Under an ASCII locale a level or file name that ASCII cannot spell is printed with
-    backslash escapes instead of ending the command with a UnicodeEncodeError."""
-    for stream in (sys.stdout, sys.stderr):
-        if isinstance(stream, io.TextIOWrapper):
-            stream.reconfigure(errors="backslashreplace")
-
-
-def _detach_stdout() -> None:
-    """Point stdout at /dev/null, so the interpreter's final flush cannot fail again."""
-    try:
-        devnull = os.open(os.devnull, os.O_WRONLY)
-        os.dup2(devnull, sys.stdout.fileno())
-        os.close(devnull)
-    except (OSError, ValueError):
-        pass
+    return guarded(body, wants_debug(words))
 
 
 if __name__ == "__main__":

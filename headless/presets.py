@@ -204,8 +204,12 @@ def _factors(data: Mapping[str, Any], src: str, fixed: Mapping[str, Any],
     table = data.get("factors", {})
     if not isinstance(table, Mapping):
         raise _fail(src, "factors", "expected a table: config key = [values]")
+    try:
+        flat = flatten(table)
+    except ConfigError as error:
+        raise _fail(src, "factors", str(error)) from None
     factors = []
-    for key, values in sorted(flatten(table).items()):
+    for key, values in sorted(flat.items()):
         where = f"factors.{key}"
         if key in fixed:
             raise _fail(src, where, "is also in [set]: a key is either fixed or a factor")
@@ -356,8 +360,8 @@ def parse_preset(
     overrides_table = data.get("set", {})
     if not isinstance(overrides_table, Mapping):
         raise _fail(src, "set", "expected a table of config overrides (dotted keys)")
-    flat = {**flatten(overrides_table), **(extra or {})}
     try:
+        flat = {**flatten(overrides_table), **(extra or {})}
         config = Config.load(flat)
     except ConfigError as error:
         raise _fail(src, "set", str(error)) from None

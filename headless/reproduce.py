@@ -78,10 +78,11 @@ def cmd_sim_from(args: argparse.Namespace) -> int:
     trial = stored_trial(args.from_dir, args.trial)
     spec = spec_of(trial)
     if args.trace:
-        try:
-            handle = open(args.trace, "w", encoding="utf-8")
-        except OSError as error:
-            raise UserError(f"--trace {args.trace}: cannot write ({error.strerror})") from None
+        from .outputs.clobber import level_file, open_output, plugin_files
+
+        handle = open_output("--trace", args.trace, [
+            Path(args.from_dir) / STORE_NAME, level_file(spec.level),
+            *plugin_files(spec.stimuli)])
         with handle:
             row = run_trial(spec, trace=handle, explain=args.explain)
     else:

@@ -37,6 +37,8 @@ from typing import Any
 
 from game.metrics import Metric, registered_metrics
 
+from .errors import SweepError
+
 __all__ = ["IDENTITY", "STORE_NAME", "ResultStore", "StoredTrial", "metric_columns", "pack",
            "stored_value", "unpack"]
 
@@ -128,6 +130,18 @@ def stored_value(value: Any) -> Any:
     return value
 
 
+def _json_column(trial: Mapping[str, Any], column: str, empty: str, kind: type) -> Any:
+    """A JSON column's value, which must decode to ``kind`` (ValueError naming it if not)."""
+    text = trial.get(column)
+    try:
+        value = json.loads(text or empty)
+    except (ValueError, TypeError):
+        raise ValueError(f"column {column} is not JSON: {str(text)[:40]!r}") from None
+    if not isinstance(value, kind):
+        raise ValueError(f"column {column} is {type(value).__name__}, not {kind.__name__}")
+    return value
+
+
 class StoredTrial(dict[str, Any]):
     """One ``trials`` row as a dict; ``visits``/``attacks`` already decoded to lists."""
 
@@ -155,6 +169,7 @@ class ResultStore:
             self.db.commit()
         self.db.row_factory = sqlite3.Row
         present = {r[1] for r in self.db.execute("PRAGMA table_info(trials)")}
+        self._has_trials = bool(present)
         #: metric columns the file has (a read-only older store may lack new ones)
         self.metric_names = tuple(m.name for m in self.metrics if m.name in present)
         self.columns = (*_HEAD, *self.metric_names,
@@ -260,17 +275,33 @@ class ResultStore:
         columns = [c for c in self.columns if heatmaps or c not in ("visits", "attacks")]
         order = ", ".join((*IDENTITY, "key"))  # key: factor levels of one identity in order
         query = f"SELECT {', '.join(columns)} FROM trials WHERE {where} ORDER BY {order}"
+        if not self._has_trials:
+            raise SweepError(f"{self.path}: not a results store (it has no trials table)")
         for r in self.db.execute(query):
             trial = StoredTrial(zip(columns, tuple(r)))
-            for m in self.metrics:
-                if m.kind == "bool" and trial.get(m.name) is not None:
-                    trial[m.name] = bool(trial[m.name])
-                elif m.name not in self.metric_names:
-                    trial[m.name] = None  # an older read-only store without the column
-            trial["overrides"] = json.loads(trial["overrides"])
-            trial["extra_metrics"] = json.loads(trial["extra_metrics"] or "{}")
-            trial["factors"] = json.loads(trial.get("factors") or "{}")
-            if heatmaps:
-                trial["visits"] = unpack(trial["visits"])
-                trial["attacks"] = unpack(trial["attacks"])
+            try:
+                self._decode(trial, heatmaps)
+            except (ValueError, TypeError, zlib.error) as error:  # a hand-edited or foreign row
+                raise SweepError(f"{self.path}: trial {trial.get('key')!r}: "
+                                 f"{' '.join(str(error).split())}") from None
             yield trial
+
+    def _decode(self, trial: StoredTrial, heatmaps: bool) -> None:
+        """Turn one row's stored text into values, refusing what no sweep writes (a metric
+        that is text, a JSON column that is not JSON)."""
+        for m in self.metrics:
+            value = trial.get(m.name)
+            if m.name not in self.metric_names:
+                trial[m.name] = None  # an older read-only store without the column
+            elif value is None:
+                continue
+            elif isinstance(value, bool) or not isinstance(value, (int, float)):
+                raise ValueError(f"metric {m.name} holds {str(value)[:40]!r}, not a number")
+            elif m.kind == "bool":
+                trial[m.name] = bool(value)
+        trial["overrides"] = _json_column(trial, "overrides", "{}", dict)
+        trial["extra_metrics"] = _json_column(trial, "extra_metrics", "{}", dict)
+        trial["factors"] = _json_column(trial, "factors", "{}", dict)
+        if heatmaps:
+            trial["visits"] = unpack(trial["visits"])
+            trial["attacks"] = unpack(trial["attacks"])

@@ -29,6 +29,7 @@ from typing import IO, Any
 
 from game.config_file import read_config_file
 from game.trial import TrialSpec
+from navmesh.level import zone_kinds
 
 from .outputs.dirlock import DirectoryLock
 from .errors import SweepError
@@ -196,6 +197,8 @@ def run_sweep(
             "config_hash": preset.config_hash, "total_trials": str(design_trials(design)),
             "config": json.dumps(dict(preset.config), sort_keys=True),
             "level_digests": json.dumps(digests, sort_keys=True),
+            # what a report needs of the plugins, as data: it never imports them
+            "zone_kinds": json.dumps(list(zone_kinds())),
             "updated_at": now,
         }
         if store.get_meta("created_at") is None:

@@ -16,6 +16,8 @@ import sys
 from collections.abc import Mapping, Sequence
 from pathlib import Path
 
+from ..failure import GuardedParser, guarded, wants_debug
+from ..outputs.clobber import refuse_inputs_all
 from .markers import replace_marked
 from .paper import paper_table3
 
@@ -76,7 +78,14 @@ def beside_paper(directory: Path, literal: Path | None = None) -> str:
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(prog="python -m headless.beside_paper",
+    """``python -m headless.beside_paper``: its exit code; every failure one ``stealth: error:`` line
+    (:func:`headless.failure.guarded`, as for ``stealth``)."""
+    words = list(sys.argv[1:] if argv is None else argv)
+    return guarded(lambda: _main(words), wants_debug(words))
+
+
+def _main(argv: Sequence[str]) -> int:
+    parser = GuardedParser(prog="python -m headless.beside_paper",
                                      description=__doc__.split("\n\n")[0])
     parser.add_argument("dir", type=Path, help="a report of the paper preset")
     parser.add_argument("--literal", type=Path, default=None,
@@ -84,6 +93,10 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser.add_argument("--write", type=Path, default=None,
                         help="replace the marked part of this Markdown file instead of printing")
     args = parser.parse_args(argv)
+    if args.write is not None:
+        refuse_inputs_all("--write", [args.write], [args.dir / n for n in ("table.csv", "table.md")]
+                          + ([args.literal / "table.csv", args.literal / "table.md"]
+                             if args.literal else []))
     text = beside_paper(args.dir, args.literal)
     if args.write is None:
         sys.stdout.write(text)

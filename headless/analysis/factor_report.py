@@ -21,6 +21,7 @@ from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
+from .reproducible import save_figure
 from .stats import Stat, summarise
 from .tables import (GUARD_NAMES, ABSTRACTION_NAMES, _Durations, csv_value, label, metric_value,
                      table_columns, table_rows, write_table)
@@ -110,7 +111,7 @@ def _figure(trials: Sequence[Mapping[str, Any]], key: str, abstraction: str, pat
     fig.suptitle(f"{label(ABSTRACTION_NAMES, abstraction)}: Table 3 against {key} "
                  "(mean, 95 % bootstrap CI)")
     fig.tight_layout()
-    fig.savefig(path)
+    save_figure(fig, path)
     return True
 
 

@@ -22,6 +22,7 @@ import numpy as np
 
 from game.metrics import TableColumn
 
+from .reproducible import save_figure
 from ..outputs.filenames import output_path
 from .palette import guard_colour
 from .tables import ABSTRACTION_NAMES, GUARD_NAMES, GUARD_SHORT, PLAYER_NAMES, PLAYER_SHORT, label
@@ -166,7 +167,7 @@ def save(fig: Any, stem: Path, **kwargs: Any) -> list[Path]:
     """``fig`` as ``stem.png`` and ``stem.svg`` (:data:`FORMATS`); returns the files."""
     paths = [stem.with_name(f"{stem.name}.{fmt}") for fmt in FORMATS]
     for path in paths:
-        fig.savefig(path, **kwargs)
+        save_figure(fig, path, **kwargs)
     return paths
 
 

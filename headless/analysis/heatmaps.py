@@ -209,6 +209,7 @@ def write_heatmaps(sums: HeatSums, directory: Path, figures: bool = True,
     side-by-side figure (PNG and SVG) per level x abstraction x kind; returns the files.
     ``tick`` is called after each figure (progress)."""
     from navmesh.graph import graph_for
+    from navmesh.errors import LevelError
     from navmesh.level import load_level
 
     from .figures import save
@@ -225,8 +226,15 @@ def write_heatmaps(sums: HeatSums, directory: Path, figures: bool = True,
         heats.sort(key=lambda item: (order.get(item[0], len(order)), item[0]))
         ref = heats[0][1].level_ref
         if level_name not in levels:
-            levels[level_name] = load_level(ref)
+            try:
+                levels[level_name] = load_level(ref)
+            except LevelError as error:  # moved, or zones of a plugin the store does not name
+                print(f"stealth: warning: {level_name}: heatmaps skipped ({error})",
+                      file=sys.stderr)
+                levels[level_name] = None
         level = levels[level_name]
+        if level is None:
+            continue
         graph = graph_for(level, abstraction)
         usable = []
         for mode, heat in heats:

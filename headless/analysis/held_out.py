@@ -22,7 +22,10 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+from .reproducible import save_figure
+from ..failure import GuardedParser, guarded, wants_debug
 from .beside_paper import COLUMNS
+from ..outputs.clobber import refuse_inputs_all
 from ..errors import UserError
 from .markers import replace_marked
 from ..tune.objective import Cell, Target, aggregate, load_target
@@ -97,6 +100,8 @@ def _target_for(trials: Sequence[Mapping[str, Any]], name: str) -> Target:
 
 
 def _share(rows: Sequence[Compared]) -> str:
+    if not rows:  # e.g. a capture-rate column of a store without capture-scenario cells
+        return "– (no cells)"
     within = sum(r.within for r in rows)
     return f"{within}/{len(rows)} ({within / len(rows):.0%})"
 
@@ -104,7 +109,7 @@ def _share(rows: Sequence[Compared]) -> str:
 def distance(rows: Sequence[Compared]) -> float:
     """The tune objective of these cells (:meth:`headless.tune.objective.Target.distance`)."""
     scaled = [r.scaled if math.isfinite(r.scaled) else 10.0 for r in rows]
-    return sum(e * e for e in scaled) / len(scaled)
+    return sum(e * e for e in scaled) / len(scaled) if scaled else math.nan
 
 
 def held_out_markdown(ours: Sequence[Compared], seeds: str,
@@ -197,11 +202,18 @@ def plot_errors(ours: Sequence[Compared], path: Path, title: str) -> None:
         fig.colorbar(image, ax=ax, shrink=0.9)
     fig.suptitle(title, fontsize=10)
     fig.tight_layout()
-    fig.savefig(path)
+    save_figure(fig, path)
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(prog="python -m headless.held_out",
+    """``python -m headless.held_out``: its exit code; every failure one ``stealth: error:`` line
+    (:func:`headless.failure.guarded`, as for ``stealth``)."""
+    words = list(sys.argv[1:] if argv is None else argv)
+    return guarded(lambda: _main(words), wants_debug(words))
+
+
+def _main(argv: Sequence[str]) -> int:
+    parser = GuardedParser(prog="python -m headless.held_out",
                                      description=__doc__.split("\n\n")[0])
     parser.add_argument("dir", type=Path, help="a results directory (results.sqlite)")
     parser.add_argument("--seeds-from", type=int, default=0, metavar="K",
@@ -217,9 +229,14 @@ def main(argv: Sequence[str] | None = None) -> int:
     try:
         if args.seeds_from < 0:
             raise UserError(f"--seeds-from: must be at least 0, got {args.seeds_from}")
+        refuse_inputs_all("--figure/--write", [p for p in (args.figure, args.write) if p],
+                          [args.dir / "results.sqlite", args.baseline and args.baseline / "results.sqlite"])
         trials = held_out_trials(args.dir, args.seeds_from)
         target = _target_for(trials, args.target)
         ours = compare(trials, target)
+        if not ours:
+            raise UserError(f"{args.dir}: no cell of the target {args.target!r} has trials of "
+                            "these abstractions, guard modes and player policies")
         baseline = None
         seeds = sorted({int(t["seed"]) for t in trials})
         if args.baseline is not None:  # on exactly our seeds (a store still running has fewer)

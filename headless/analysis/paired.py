@@ -18,6 +18,7 @@ from typing import Any
 
 import numpy as np
 
+from ..failure import GuardedParser, guarded, wants_debug
 from .stats import bootstrap_ci
 from ..store import STORE_NAME, ResultStore
 
@@ -98,7 +99,14 @@ def paired_table(rows: Sequence[Mapping[str, Any]], arm: str = "arm",
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(prog="python -m headless.paired",
+    """``python -m headless.paired``: its exit code; every failure one ``stealth: error:`` line
+    (:func:`headless.failure.guarded`, as for ``stealth``)."""
+    words = list(sys.argv[1:] if argv is None else argv)
+    return guarded(lambda: _main(words), wants_debug(words))
+
+
+def _main(argv: Sequence[str]) -> int:
+    parser = GuardedParser(prog="python -m headless.paired",
                                      description=(__doc__ or "").split("\n\n")[0])
     parser.add_argument("arm", type=Path, help="results directory of the arm")
     parser.add_argument("control", type=Path, help="results directory of the control")

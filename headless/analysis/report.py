@@ -33,9 +33,11 @@ import csv
 import json
 import sys
 from pathlib import Path
+from typing import Any
 
-from ai.stimuli import load_stimulus
+from navmesh.level import register_zone_kind
 
+from ..outputs.clobber import plugin_files, refuse_inputs_all
 from ..errors import UserError
 from .factor_report import write_factor_report
 from .figures import FORMATS, write_aggregate
@@ -90,9 +92,10 @@ def write_report(directory: str | Path, *, figures: bool = True,
         raise UserError(f"{store_path}: no finished trials yet"
                         + (f" ({len(failures)} failed)" if failures else ""))
 
-    design = json.loads(meta.get("design", "{}"))
-    for plugin in design.get("stimuli", []):  # their zone kinds, before the levels are read
-        load_stimulus(plugin)
+    design = _design(meta, store_path)
+    _register_stored_zone_kinds(meta, design, store_path)
+    refuse_inputs_all("report", [directory / name for name in _FIXED_OUTPUTS],
+                      [*{t.get("level") for t in trials}, *_plugin_files(design)])
     written: list[Path] = []
     path = directory / "trials.csv"
     write_trials_csv(trials, path)
@@ -131,6 +134,57 @@ def write_report(directory: str | Path, *, figures: bool = True,
                            written + [path]), encoding="utf-8")
     written.append(path)
     return written
+
+
+_FIXED_OUTPUTS = ("trials.csv", "table.md", "table.csv", "failed.csv", "README.md",
+                  "factors.md", "factors.csv", "sessions.md", "sessions.csv")
+
+
+def _plugin_files(design: dict[str, Any]) -> list[str]:
+    stimuli = design.get("stimuli", [])
+    return plugin_files(s for s in stimuli if isinstance(s, str)) if isinstance(stimuli, list) else []
+
+
+def _design(meta: dict[str, str], store_path: Path) -> dict[str, Any]:
+    """The store's design (``meta.design``): a JSON object, or one line naming the store."""
+    try:
+        design = json.loads(meta.get("design", "{}"))
+    except ValueError:
+        raise UserError(f"{store_path}: meta.design is not JSON") from None
+    if not isinstance(design, dict):
+        raise UserError(f"{store_path}: meta.design is {type(design).__name__}, not an object")
+    return design
+
+
+MAX_ZONE_KINDS = 256
+"""Most zone kinds a store may name (a hostile store must not make the report crawl)."""
+
+
+def _register_stored_zone_kinds(meta: dict[str, str], design: dict[str, Any],
+                                store_path: Path) -> None:
+    """Let the levels use the zone kinds the sweep stored (``meta.zone_kinds``, data).
+
+    A report never imports the plugins a store names: a results folder shared with a
+    ``.py`` inside must not run it. A store written before the kinds were stored reports
+    without them (a level using a plugin's zone kind then has no heatmap), after one note.
+    """
+    stored = meta.get("zone_kinds")
+    if stored is None:
+        if design.get("stimuli"):
+            print(f"stealth: note: {store_path} predates stored zone kinds; its plugins are "
+                  "not imported, so levels with their zones get no heatmap", file=sys.stderr)
+        return
+    try:
+        kinds = json.loads(stored)
+        if not isinstance(kinds, list):
+            raise ValueError(f"a {type(kinds).__name__}")
+        if len(kinds) > MAX_ZONE_KINDS:
+            raise ValueError(f"{len(kinds)} kinds, more than {MAX_ZONE_KINDS}")
+        for kind in kinds:
+            register_zone_kind(kind)
+    except ValueError as error:
+        raise UserError(f"{store_path}: meta.zone_kinds is not a list of zone kinds ({error})"
+                        ) from None
 
 
 def cmd_report(args: argparse.Namespace) -> int:

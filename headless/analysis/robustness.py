@@ -29,6 +29,9 @@ from typing import Any
 
 import numpy as np
 
+from .reproducible import save_figure
+from ..failure import GuardedParser, guarded, wants_debug
+from ..outputs.clobber import refuse_inputs_all
 from ..errors import UserError
 from .markers import replace_marked
 from .factor_report import numeric_factors
@@ -252,7 +255,7 @@ def draw(judgements: Sequence[Judgement], path: Path, axes: Axes) -> None:
     fig.suptitle("The paper's claims per factor cell. In each cell the deciding comparison "
                  "A−B:\nmean paired difference [95 % bootstrap CI]", fontsize=9)
     fig.tight_layout(rect=(0, 0.03, 1, 0.98))
-    fig.savefig(path)
+    save_figure(fig, path)
 
 
 def _rect(i: int, k: int, colour: str) -> Any:
@@ -307,7 +310,14 @@ def write_between_markers(path: Path, text: str) -> None:
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(prog="python -m headless.robustness",
+    """``python -m headless.robustness``: its exit code; every failure one ``stealth: error:`` line
+    (:func:`headless.failure.guarded`, as for ``stealth``)."""
+    words = list(sys.argv[1:] if argv is None else argv)
+    return guarded(lambda: _main(words), wants_debug(words))
+
+
+def _main(argv: Sequence[str]) -> int:
+    parser = GuardedParser(prog="python -m headless.robustness",
                                      description=(__doc__ or "").split("\n\n")[0])
     parser.add_argument("store", type=Path, help="results directory of a two-factor design")
     parser.add_argument("--write", type=Path, default=None,
@@ -315,6 +325,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser.add_argument("--figure", type=Path, default=None, help="PNG of the verdicts")
     args = parser.parse_args(argv)
     try:
+        refuse_inputs_all("--figure/--write", [p for p in (args.figure, args.write) if p],
+                          [args.store / STORE_NAME])
         if not (args.store / STORE_NAME).is_file():
             raise UserError(f"{args.store}: no {STORE_NAME} here")
         with ResultStore(args.store / STORE_NAME, readonly=True) as store:

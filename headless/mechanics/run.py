@@ -22,6 +22,8 @@ import numpy as np
 
 from navmesh.level import load_level
 
+from ..errors import UserError
+from ..outputs.clobber import level_file, refuse_inputs_all
 from .measures import BOOTSTRAP, DRAW_DISTANCES, EXPECTED, MECHANICS, Row, run_job
 from ..executors import check_workers, process_pool
 from ..outputs.filenames import output_path
@@ -233,12 +235,36 @@ def write_results(out: Path, rows: Sequence[Row], summaries: Sequence[Summary], 
         writer.writerows(rows)
 
 
+MAX_SEEDS = 10_000
+"""Most paired seeds per mechanic ``stealth mechanics --seeds`` runs (30 by default)."""
+
+
+MIN_WALKABLE = 16
+"""Fewest walkable cells a level needs for the mechanics (a decoy 8 hops from the guards)."""
+
+
+def check_mechanics_level(level: Any, name: str) -> None:
+    """Refuse, before any trial, a level the built-in mechanics cannot be measured on: the
+    dark and concealment measurements place the player in such a zone, the decoy walks
+    guards to a far node."""
+    missing = [kind for kind in ("dark", "concealment") if not level.zones.get(kind)]
+    if missing:
+        raise UserError(f"--level {name}: the mechanics need a {' and a '.join(missing)} "
+                        f"zone; this level has none")
+    walkable = int(level.occupancy.sum())
+    if walkable < MIN_WALKABLE or not level.guards:
+        raise UserError(f"--level {name}: the mechanics need at least {MIN_WALKABLE} walkable "
+                        f"cells and a guard; this level has {walkable} and {len(level.guards)}")
+
+
 def refuse_arguments(args: argparse.Namespace) -> int | None:
     """The checks of ``stealth mechanics`` with or without ``--stimulus``: 2 (after the
     one-line message) for too few seeds, else None; a bad ``--workers`` raises."""
     if args.seeds < 2:
         print("stealth: error: --seeds: need at least 2 seeds", file=sys.stderr)
         return 2
+    if args.seeds > MAX_SEEDS:
+        raise UserError(f"--seeds: at most {MAX_SEEDS} paired seeds per mechanic, got {args.seeds}")
     if args.workers is not None:
         check_workers(args.workers)
     return None
@@ -255,6 +281,11 @@ def cmd_mechanics(args: argparse.Namespace) -> int:
     except ValueError as error:
         print(f"stealth: error: {error}", file=sys.stderr)
         return 2
+    check_mechanics_level(level, args.level)
+    refuse_inputs_all("--out", [output_path(Path(args.out), *name, suffix=suffix) for name, suffix
+                                in ((("mechanics",), ".md"), (("mechanics",), ".csv"),
+                                    (("mechanics", "trials"), ".csv"))],
+                      [level_file(args.level)])
     Path(args.out).mkdir(parents=True, exist_ok=True)  # an OSError now, not after the trials
     rows, seconds = run_mechanics(args.seeds, args.level, args.abstraction, args.workers)
     table = markdown(summarise(rows), draw_curve(rows), level.name, args.abstraction,

@@ -48,7 +48,7 @@ class DirectoryLock:
     True
     """
 
-    def __init__(self, folder: Path) -> None:
+    def __init__(self, folder: Path, what: str = "sweep") -> None:
         self.path = folder / LOCK_NAME
         self._handle: IO[str] | None = None
         try:
@@ -60,7 +60,7 @@ class DirectoryLock:
             fcntl.flock(handle, fcntl.LOCK_EX | fcntl.LOCK_NB)
         except OSError:
             handle.close()
-            raise SweepError(f"{folder}: another sweep is writing to this directory "
+            raise SweepError(f"{folder}: another {what} is writing to this directory "
                              f"(pid {self._holder()})") from None
         handle.seek(0)
         handle.truncate()

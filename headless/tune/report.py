@@ -18,6 +18,8 @@ from typing import TYPE_CHECKING, Any
 
 from game.config_file import write_config_file
 
+from ..analysis.reproducible import save_figure
+
 if TYPE_CHECKING:
     from .study import TuneSpec
 
@@ -56,7 +58,7 @@ def _history(study: Any, direction: str, path: Path) -> None:
     ax.set_ylabel("objective")
     ax.set_title(f"stealth tune: history ({direction})")
     fig.tight_layout()
-    fig.savefig(path)
+    save_figure(fig, path)
 
 
 def _params(study: Any, path: Path) -> None:
@@ -85,7 +87,7 @@ def _params(study: Any, path: Path) -> None:
                 ax.set_ylabel("objective" if i == 0 else "% cells within tol.", fontsize=8)
     fig.suptitle("stealth tune: each trial against each searched parameter", fontsize=9)
     fig.tight_layout()
-    fig.savefig(path)
+    save_figure(fig, path)
 
 
 def _study_csv(study: Any, path: Path) -> None:

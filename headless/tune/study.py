@@ -42,9 +42,11 @@ from navmesh.files import FileRefused, read_regular
 from ..errors import SweepError, UserError
 from ..executors import (InlineExecutor, connect_dask, process_pool, run_batch, shutdown,
                         terminate)
-from .expr import Expression, parse_constraint, parse_expression
+from ..outputs.dirlock import DirectoryLock
+from .expr import Expression, ExpressionError, parse_constraint, parse_expression
 from .objective import Target, as_trials, check_names, load_target, lookup_for
 from ..presets import MAX_PRESET_BYTES, Preset, check_setting, parse_preset
+from .study_file import STUDY_FILE, check_study_file, study_errors
 
 __all__ = ["Param", "TuneSpec", "cmd_tune", "load_tune_spec", "run_study"]
 
@@ -251,8 +253,19 @@ def run_study(spec: TuneSpec, out: Path, trials: int, *, workers: int | None = N
     warnings.filterwarnings("ignore", category=optuna.exceptions.ExperimentalWarning)
     if out.exists() and not out.is_dir():
         raise UserError(f"--out {out}: exists and is not a directory")
-    out.mkdir(parents=True, exist_ok=True)
-    storage = f"sqlite:///{(out / 'study.db').resolve()}"
+    try:
+        out.mkdir(parents=True, exist_ok=True)
+    except OSError as error:
+        raise SweepError(f"--out {out}: cannot create ({error.strerror or error})") from None
+    with DirectoryLock(out, "study"), study_errors(out / STUDY_FILE):
+        check_study_file(out / STUDY_FILE)
+        return _run_study(optuna, TrialState, spec, out, trials, workers, scheduler, stream)
+
+
+def _run_study(optuna: Any, TrialState: Any, spec: TuneSpec, out: Path, trials: int,
+               workers: int | None, scheduler: str | None, stream: Any) -> Path:
+    """:func:`run_study` once the study directory is locked and its file checked."""
+    storage = f"sqlite:///{(out / STUDY_FILE).resolve()}"
     study = optuna.create_study(storage=storage, study_name=STUDY_NAME,
                                 direction=spec.direction, load_if_exists=True)
     old = study.user_attrs.get("spec")
@@ -275,6 +288,7 @@ def run_study(spec: TuneSpec, out: Path, trials: int, *, workers: int | None = N
             parallelism = workers or os.cpu_count() or 1
             executor = process_pool(parallelism)
         seeds = range(spec.seeds_train)
+        failed_in_a_row = 0
         while True:
             finished = study.get_trials(deepcopy=False, states=[TrialState.COMPLETE])
             if len(finished) >= trials:
@@ -288,7 +302,12 @@ def run_study(spec: TuneSpec, out: Path, trials: int, *, workers: int | None = N
             except BaseException:
                 current.tell(trial, state=TrialState.FAIL)
                 raise
-            value, cons, facts = spec.score(rows)
+            try:
+                value, cons, facts = spec.score(rows)
+            except ExpressionError as error:  # e.g. a division by a metric that was 0
+                current.tell(trial, state=TrialState.FAIL)
+                failed_in_a_row = _failed(failed_in_a_row, trial.number, str(error), stream)
+                continue
             trial.set_user_attr("constraints", cons)
             for number, amount in enumerate(cons):  # <= 0 holds; TPE prefers feasible trials
                 trial.set_constraint(f"c{number}", amount)
@@ -296,9 +315,10 @@ def run_study(spec: TuneSpec, out: Path, trials: int, *, workers: int | None = N
                 trial.set_user_attr(name, fact)
             if not math.isfinite(value):
                 current.tell(trial, state=TrialState.FAIL)
-                stream.write(f"stealth: tune trial {trial.number}: objective is not a number "
-                             "(a metric without trials?)\n")
+                failed_in_a_row = _failed(failed_in_a_row, trial.number, "objective is not a "
+                                          "number (a metric without trials?)", stream)
                 continue
+            failed_in_a_row = 0
             current.tell(trial, value)
             stream.write(f"stealth: tune trial {trial.number} ({len(finished) + 1}/{trials}): "
                          f"{value:.6g} {json.dumps(values)}\n")
@@ -331,12 +351,31 @@ def run_study(spec: TuneSpec, out: Path, trials: int, *, workers: int | None = N
     return out
 
 
+MAX_FAILED_IN_A_ROW = 20
+"""Trials in a row without an objective value after which a study stops (one line)."""
+
+
+def _failed(count: int, number: int, why: str, stream: Any) -> int:
+    """Report a trial without a value; :class:`UserError` after too many in a row (a study
+    whose objective can never be computed would otherwise ask for ever)."""
+    stream.write(f"stealth: tune trial {number}: {why}\n")
+    if count + 1 >= MAX_FAILED_IN_A_ROW:
+        raise UserError(f"{MAX_FAILED_IN_A_ROW} tune trials in a row gave no objective value; "
+                        f"the last: {why}")
+    return count + 1
+
+
 def cmd_tune(args: argparse.Namespace) -> int:
     """``stealth tune SPEC.toml --out DIR [--trials N] [--workers N] [--config FILE]``."""
     if args.trials < 1:
         raise UserError(f"--trials: must be at least 1, got {args.trials}")
     if args.workers is not None and args.workers < 1:
         raise UserError(f"--workers: must be at least 1, got {args.workers}")
+    from ..outputs.clobber import refuse_inputs_all
+
+    refuse_inputs_all("--out", [Path(args.out) / name for name in (
+        "best.toml", "study.csv", "report.md", "history.png", "params.png", "results.lock")],
+                      [args.spec, args.config])
     extra = read_config_file(args.config) if args.config else None
     spec = load_tune_spec(args.spec, extra)
     out = Path(args.out)
