@@ -290,7 +290,7 @@ def _cmd_mechanics(args: argparse.Namespace) -> int:
 
 def _cmd_play(args: argparse.Namespace) -> int:
     from game.config_file import read_config_file
-    from game.front.play import cmd_play
+    from game.front.play_command import cmd_play
 
     if args.config:  # the file's overrides first, so --set still wins
         args.set = [f"{k}={v}" for k, v in read_config_file(args.config).items()] + args.set
