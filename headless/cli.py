@@ -13,13 +13,11 @@ from __future__ import annotations
 import argparse
 import errno
 import io
-import json
 import os
 import sqlite3
 import sys
 import traceback
-from collections.abc import Mapping, Sequence
-from pathlib import Path
+from collections.abc import Sequence
 from typing import Any, NoReturn
 
 from ai import GUARD_MODES, PLAYER_POLICIES
@@ -27,9 +25,10 @@ from navmesh.errors import StealthError
 from navmesh.graph import ABSTRACTIONS
 
 from . import warning_lines
-from .errors import UserError
-
-EXIT_USER_ERROR = 2
+from .commands.levels import cmd_levels, cmd_path, cmd_validate
+from .commands.output import EXIT_USER_ERROR, _emit_json
+from .commands.sim import cmd_sim
+from .errors import UsageError
 
 
 def _point(text: str) -> tuple[float, float]:
@@ -55,199 +54,6 @@ def _seed(text: str) -> int:
     if problem is not None:
         raise argparse.ArgumentTypeError(f"{value} {problem}")
     return value
-
-
-def _emit_json(document: Any) -> None:
-    json.dump(document, sys.stdout, indent=2)
-    sys.stdout.write("\n")
-
-
-# ---------------------------------------------------------------------- levels / validate
-def _navmesh(level: Any) -> Any:
-    """The level's navmesh (the partition graph's, cached per process)."""
-    from navmesh.graph import graph_for
-
-    mesh = graph_for(level, "partition").mesh
-    if mesh is None:  # pragma: no cover - a partition graph always has its mesh
-        raise RuntimeError(f"level {level.name}: the partition graph has no navmesh")
-    return mesh
-
-
-def level_stats(level: Any) -> dict[str, Any]:
-    """Paper Table 1 for one level: navmesh triangles and areas, grid size and counts."""
-    mesh = _navmesh(level)
-    walkable = int(level.occupancy.sum())
-    return {
-        "name": level.name,
-        "triangles": int(len(mesh.triangles)),
-        "min_area": round(float(mesh.areas.min()), 4),
-        "max_area": round(float(mesh.areas.max()), 4),
-        "avg_area": round(float(mesh.areas.mean()), 4),
-        "rows": level.rows,
-        "cols": level.cols,
-        "walkable": walkable,
-        "blocked": int(level.occupancy.size - walkable),
-    }
-
-
-def cmd_levels(args: argparse.Namespace) -> int:
-    from navmesh.level import bundled_level_names, load_level
-
-    from navmesh.sizing import check_fits
-
-    names = args.level or bundled_level_names()
-    levels = [load_level(name) for name in names]
-    for name, level in zip(names, levels, strict=True):
-        check_fits(level, str(name))  # refuse before building what cannot fit
-    rows = [level_stats(level) for level in levels]
-    if args.json:
-        _emit_json(rows)
-        return 0
-    header = f"{'level':<12}{'tris':>6}{'min area':>10}{'max area':>10}{'avg area':>10}" \
-             f"{'rows':>6}{'cols':>6}{'walkable':>10}{'blocked':>9}"
-    print(header)
-    for r in rows:
-        total = r["walkable"] + r["blocked"]
-        print(
-            f"{r['name']:<12}{r['triangles']:>6}{r['min_area']:>10.4f}{r['max_area']:>10.4f}"
-            f"{r['avg_area']:>10.4f}{r['rows']:>6}{r['cols']:>6}"
-            f"{r['walkable']:>5} ({100 * r['walkable'] / total:2.0f}%)"
-            f"{r['blocked']:>4} ({100 * r['blocked'] / total:2.0f}%)"
-        )
-    return 0
-
-
-def cmd_validate(args: argparse.Namespace) -> int:
-    from navmesh.errors import LevelError
-    from navmesh.sizing import check_fits
-    from navmesh.level import load_level
-
-    from ai.stimuli import load_stimulus
-
-    for plugin in args.stimulus:  # its zone kinds, before the levels that use them
-        load_stimulus(plugin)
-    failed = 0
-    for name in args.level:
-        try:
-            level = load_level(name)
-            check_fits(level, str(name))
-        except LevelError as error:
-            print(f"stealth: error: {error}", file=sys.stderr)
-            failed += 1
-        else:
-            if not _body_fits(name, level):
-                failed += 1
-                continue
-            print(f"{name}: ok ({level.name}, {level.rows}x{level.cols}, "
-                  f"{int(level.occupancy.sum())} walkable cells)", file=sys.stderr)
-    return EXIT_USER_ERROR if failed else 0
-
-
-def _body_fits(name: str, level: Any) -> bool:
-    """Warn of passages narrower than an agent (``world.agent_radius``); False, after one
-    error line, when the walkable area is disconnected for its body."""
-    from game.config import Config
-    from navmesh.clearance import clearance_for
-
-    radius = float(Config.defaults()["world.agent_radius"])
-    report = clearance_for(level, radius).report()
-    src = Path(name).name if Path(name).suffix else name
-    for x, y in report.narrow:
-        print(f"{src}: warning: passage narrower than {2 * radius:g} units near ({x:.1f}, {y:.1f})",
-              file=sys.stderr)
-    if report.connected:
-        return True
-    where = ", ".join(f"({x:.1f}, {y:.1f})" for x, y in report.piece_points[:4])
-    print(f"stealth: error: {src}: walkable area: an agent of radius {radius:g} cannot reach "
-          f"the whole level: it is in {len(report.pieces)} pieces for its body (near {where})",
-          file=sys.stderr)
-    return False
-
-
-# ---------------------------------------------------------------------- path
-def cmd_path(args: argparse.Namespace) -> int:
-    from navmesh.level import load_level
-
-    path = _navmesh(load_level(args.level)).find_path(args.from_, args.to)
-    points = [[float(x), float(y)] for x, y in path.points]
-    if args.json:
-        _emit_json({"points": points, "length": float(path.length)})
-    else:
-        print(f"length {float(path.length):.4f} through {len(points)} points")
-        for x, y in points:
-            print(f"  {x:.4f},{y:.4f}")
-    return 0
-
-
-# ---------------------------------------------------------------------- sim
-def _overrides(items: Sequence[str], level: Any, base: Mapping[str, Any] | None = None
-               ) -> tuple[tuple[str, Any], ...]:
-    """The ``--config`` file's settings (``base``) overridden by the ``--set`` pairs, every
-    key and value checked now, also against the level (one-line ConfigError before any
-    file is written)."""
-    from game.config import Config, parse_overrides
-    from game.schema import check_level
-
-    settings = {**(base or {}), **dict(parse_overrides(items))}
-    check_level(Config.load(settings), level)
-    return tuple(settings.items())
-
-
-def cmd_sim(args: argparse.Namespace) -> int:
-    from ai.stimuli import load_stimulus
-    from game.config_file import read_config_file
-    from game.trial import TrialSpec, run_trial, sim_document
-    from navmesh.level import load_level
-
-    if args.from_dir is not None or args.trial is not None:
-        from .reproduce import cmd_sim_from
-
-        return cmd_sim_from(args)
-    if args.level is None:
-        raise UsageError("sim: a LEVEL is required (or --from DIR --trial KEY)")
-    for plugin in args.stimulus:  # before the level: a plugin may declare its zone kinds
-        load_stimulus(plugin)  # a bad plugin fails here with its one-line message
-    level = load_level(args.level)  # a bad level fails here with its one-line message
-    spec = TrialSpec(
-        level=args.level,
-        abstraction=args.abstraction,
-        guards=args.guards,
-        player=args.player,
-        scenario=args.scenario,
-        seed=args.seed,
-        overrides=_overrides(args.set, level,
-                             read_config_file(args.config) if args.config else {}),
-        stimuli=tuple(args.stimulus),
-    )
-    if args.trace:
-        from navmesh.level import resolve_level_path
-
-        from .outputs.clobber import refuse_inputs
-
-        plugins = [p.rpartition(":")[0] for p in args.stimulus if ":" in p]
-        refuse_inputs("--trace", args.trace, [resolve_level_path(args.level), *plugins])
-        try:
-            handle = open(args.trace, "w", encoding="utf-8")
-        except OSError as error:
-            raise UserError(f"--trace {args.trace}: cannot write ({error.strerror})") from None
-        try:
-            with handle:
-                row = run_trial(spec, trace=handle, explain=args.explain)
-        except OSError as error:  # the disk filled up, the device refused: name the file
-            raise OSError(error.errno, error.strerror, args.trace) from error
-    elif args.explain:
-        row = run_trial(spec, trace=sys.stderr, explain=True)
-    else:
-        row = run_trial(spec)
-    document = sim_document(row)
-    if args.json:
-        _emit_json(document)
-    else:
-        print(f"{document['level']} {document['abstraction']} guards={document['guards']} "
-              f"player={document['player']} scenario={document['scenario']} seed={document['seed']}")
-        for key, value in document["metrics"].items():
-            print(f"  {key:<22} {value}")
-    return 0
 
 
 # ---------------------------------------------------------------------- presets
@@ -325,10 +131,6 @@ def _cmd_tune(args: argparse.Namespace) -> int:
 
 
 # ---------------------------------------------------------------------- parser
-class UsageError(UserError):
-    """A command line argparse rejects (unknown option, bad choice, missing argument)."""
-
-
 class _Parser(argparse.ArgumentParser):
     """An argparse parser whose errors are one ``stealth: error: ...`` line (exit 2)."""
 

@@ -12,7 +12,7 @@ from __future__ import annotations
 
 from navmesh.errors import StealthError, UserError
 
-__all__ = ["PresetError", "StealthError", "SweepError", "UserError"]
+__all__ = ["PresetError", "StealthError", "SweepError", "UsageError", "UserError"]
 
 
 class PresetError(UserError):
@@ -21,3 +21,7 @@ class PresetError(UserError):
 
 class SweepError(UserError):
     """A results directory, store, lock or cluster a sweep cannot use."""
+
+
+class UsageError(UserError):
+    """A command line argparse rejects (unknown option, bad choice, missing argument)."""

@@ -1,0 +1,129 @@
+"""``stealth levels``, ``validate`` and ``path``: a level's statistics, its checks, a path across it."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+from typing import Any
+
+from .output import EXIT_USER_ERROR, _emit_json
+
+__all__ = ["cmd_levels", "cmd_path", "cmd_validate", "level_stats"]
+
+
+# ---------------------------------------------------------------------- levels / validate
+def _navmesh(level: Any) -> Any:
+    """The level's navmesh (the partition graph's, cached per process)."""
+    from navmesh.graph import graph_for
+
+    mesh = graph_for(level, "partition").mesh
+    if mesh is None:  # pragma: no cover - a partition graph always has its mesh
+        raise RuntimeError(f"level {level.name}: the partition graph has no navmesh")
+    return mesh
+
+
+def level_stats(level: Any) -> dict[str, Any]:
+    """Paper Table 1 for one level: navmesh triangles and areas, grid size and counts."""
+    mesh = _navmesh(level)
+    walkable = int(level.occupancy.sum())
+    return {
+        "name": level.name,
+        "triangles": int(len(mesh.triangles)),
+        "min_area": round(float(mesh.areas.min()), 4),
+        "max_area": round(float(mesh.areas.max()), 4),
+        "avg_area": round(float(mesh.areas.mean()), 4),
+        "rows": level.rows,
+        "cols": level.cols,
+        "walkable": walkable,
+        "blocked": int(level.occupancy.size - walkable),
+    }
+
+
+def cmd_levels(args: argparse.Namespace) -> int:
+    from navmesh.level import bundled_level_names, load_level
+
+    from navmesh.sizing import check_fits
+
+    names = args.level or bundled_level_names()
+    levels = [load_level(name) for name in names]
+    for name, level in zip(names, levels, strict=True):
+        check_fits(level, str(name))  # refuse before building what cannot fit
+    rows = [level_stats(level) for level in levels]
+    if args.json:
+        _emit_json(rows)
+        return 0
+    header = f"{'level':<12}{'tris':>6}{'min area':>10}{'max area':>10}{'avg area':>10}" \
+             f"{'rows':>6}{'cols':>6}{'walkable':>10}{'blocked':>9}"
+    print(header)
+    for r in rows:
+        total = r["walkable"] + r["blocked"]
+        print(
+            f"{r['name']:<12}{r['triangles']:>6}{r['min_area']:>10.4f}{r['max_area']:>10.4f}"
+            f"{r['avg_area']:>10.4f}{r['rows']:>6}{r['cols']:>6}"
+            f"{r['walkable']:>5} ({100 * r['walkable'] / total:2.0f}%)"
+            f"{r['blocked']:>4} ({100 * r['blocked'] / total:2.0f}%)"
+        )
+    return 0
+
+
+def cmd_validate(args: argparse.Namespace) -> int:
+    from navmesh.errors import LevelError
+    from navmesh.sizing import check_fits
+    from navmesh.level import load_level
+
+    from ai.stimuli import load_stimulus
+
+    for plugin in args.stimulus:  # its zone kinds, before the levels that use them
+        load_stimulus(plugin)
+    failed = 0
+    for name in args.level:
+        try:
+            level = load_level(name)
+            check_fits(level, str(name))
+        except LevelError as error:
+            print(f"stealth: error: {error}", file=sys.stderr)
+            failed += 1
+        else:
+            if not _body_fits(name, level):
+                failed += 1
+                continue
+            print(f"{name}: ok ({level.name}, {level.rows}x{level.cols}, "
+                  f"{int(level.occupancy.sum())} walkable cells)", file=sys.stderr)
+    return EXIT_USER_ERROR if failed else 0
+
+
+def _body_fits(name: str, level: Any) -> bool:
+    """Warn of passages narrower than an agent (``world.agent_radius``); False, after one
+    error line, when the walkable area is disconnected for its body."""
+    from game.config import Config
+    from navmesh.clearance import clearance_for
+
+    radius = float(Config.defaults()["world.agent_radius"])
+    report = clearance_for(level, radius).report()
+    src = Path(name).name if Path(name).suffix else name
+    for x, y in report.narrow:
+        print(f"{src}: warning: passage narrower than {2 * radius:g} units near ({x:.1f}, {y:.1f})",
+              file=sys.stderr)
+    if report.connected:
+        return True
+    where = ", ".join(f"({x:.1f}, {y:.1f})" for x, y in report.piece_points[:4])
+    print(f"stealth: error: {src}: walkable area: an agent of radius {radius:g} cannot reach "
+          f"the whole level: it is in {len(report.pieces)} pieces for its body (near {where})",
+          file=sys.stderr)
+    return False
+
+
+# ---------------------------------------------------------------------- path
+def cmd_path(args: argparse.Namespace) -> int:
+    from navmesh.level import load_level
+
+    path = _navmesh(load_level(args.level)).find_path(args.from_, args.to)
+    points = [[float(x), float(y)] for x, y in path.points]
+    if args.json:
+        _emit_json({"points": points, "length": float(path.length)})
+    else:
+        print(f"length {float(path.length):.4f} through {len(points)} points")
+        for x, y in points:
+            print(f"  {x:.4f},{y:.4f}")
+    return 0
