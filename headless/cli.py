@@ -31,8 +31,8 @@ from typing import Any  # noqa: E402
 
 from .errors import UserError  # noqa: E402
 from .outputs import warning_lines  # noqa: E402
-from .level_commands import cmd_levels, cmd_path, cmd_validate, emit_json, level_stats  # noqa: E402
-from .failure import EXIT_USER_ERROR, GuardedParser, UsageError, guarded, os_error_line, wants_debug
+from .commands.levels import cmd_levels, cmd_path, cmd_validate, emit_json, level_stats  # noqa: E402
+from .commands.failure import EXIT_USER_ERROR, GuardedParser, UsageError, guarded, os_error_line, wants_debug
 
 __all__ = ["EXIT_USER_ERROR", "UsageError", "build_parser", "cmd_levels", "cmd_path", "cmd_validate",
            "level_stats", "main", "os_error_line"]
@@ -174,7 +174,7 @@ def _cmd_mechanics(args: argparse.Namespace) -> int:
 
 def _cmd_play(args: argparse.Namespace) -> int:
     from game.config_file import read_config_file
-    from game.front.play import cmd_play
+    from game.front.play_command import cmd_play
 
     from .outputs.clobber import level_file, plugin_files, refuse_inputs_all
 
@@ -437,7 +437,7 @@ def build_parser() -> argparse.ArgumentParser:
 def main(argv: Sequence[str] | None = None) -> int:
     """Run one ``stealth`` command; returns its exit code (2 for any user error).
 
-    Failures become one line in :func:`headless.failure.guarded` (a user's mistake, an
+    Failures become one line in :func:`headless.commands.failure.guarded` (a user's mistake, an
     OSError naming its file, a file that is not a results store, Ctrl-C — also during the
     imports of start-up, which happen inside it). ``--debug`` anywhere before ``--`` also
     prints the traceback.

@@ -36,8 +36,9 @@ from pathlib import Path
 import numpy as np
 from shapely.geometry import Polygon
 
+from navmesh.degenerate import fix_degenerate
 from navmesh.query import MAX_CORNERS, NavPath, OutsideError, PathQuery
-from navmesh.refine import Refiner, fix_degenerate
+from navmesh.refine import Refiner
 from navmesh.rings import polygon_rings
 from navmesh.triangulate import (
     cross2,

@@ -3,7 +3,8 @@
 The second stage of :meth:`navmesh.mesh.NavMesh.build`: the base triangulation of
 :mod:`navmesh.triangulate` is flipped to constrained Delaunay, then refined until every
 angle reaches the minimum angle and every area the maximum area (see ``docs/navmesh.md``).
-:func:`fix_degenerate` uses the same flips to remove the zero-area triangles earcut emits.
+:func:`navmesh.degenerate.fix_degenerate` uses the same flips to remove the zero-area
+triangles earcut emits.
 """
 
 from __future__ import annotations
@@ -13,11 +14,11 @@ import math
 
 import numpy as np
 
-from navmesh.predicates import degenerate_candidates, flip_candidates, quality_candidates, small_angle_candidates
+from navmesh.predicates import flip_candidates, quality_candidates, small_angle_candidates
 from navmesh.rings import ring_neighbours
-from navmesh.triangulate import edge_neighbors, orient_ccw, vertex_ids
+from navmesh.triangulate import edge_neighbors, vertex_ids
 
-__all__ = ["Refiner", "fix_degenerate"]
+__all__ = ["Refiner"]
 
 
 _NEXT, _PREV = (1, 2, 0), (2, 0, 1)  # (k + 1) % 3 and (k + 2) % 3
@@ -486,36 +487,3 @@ def _circumcentre(ax: float, ay: float, bx: float, by: float, cx: float, cy: flo
         return math.nan, math.nan
     b2, c2 = bx * bx + by * by, cx * cx + cy * cy
     return ax + (cy * b2 - by * c2) / d, ay + (bx * c2 - cx * b2) / d
-
-def fix_degenerate(verts: np.ndarray, tris: np.ndarray, tol: float) -> np.ndarray:
-    """Remove zero-area triangles by flipping their long edge (earcut can emit them)."""
-    tris = orient_ccw(verts, tris)
-    ref = Refiner.__new__(Refiner)
-    ref.x, ref.y = verts[:, 0].tolist(), verts[:, 1].tolist()
-    ref.tri, ref.nbr = tris.tolist(), edge_neighbors(tris).tolist()
-    ref.tol, ref.dirty, ref.bound = tol, [], {}
-
-    def flat(t: int) -> bool:
-        a, b, c = ref.tri[t]
-        longest = max(math.hypot(ref.x[q] - ref.x[r], ref.y[q] - ref.y[r]) for q, r in ((b, c), (c, a), (a, b)))
-        return ref._orient(a, b, c) <= tol * longest
-
-    # the first flat triangle each time: numpy lists those that may be flat, a heap keeps
-    # them and the triangles each flip changes in index order, the scalar test decides
-    x, y = np.asarray(ref.x), np.asarray(ref.y)
-    maybe = np.flatnonzero(degenerate_candidates(x, y, tris, tol)).tolist()
-    heapq.heapify(maybe)
-    for _ in range(len(tris) + 1):
-        while maybe and not flat(maybe[0]):
-            heapq.heappop(maybe)
-        if not maybe:
-            break
-        bad = maybe[0]
-        a, b, c = ref.tri[bad]
-        # the vertex lying between the other two is opposite the long edge: flip that edge
-        lens = [math.hypot(ref.x[q] - ref.x[r], ref.y[q] - ref.y[r]) for q, r in ((b, c), (c, a), (a, b))]
-        k = int(np.argmax(lens))
-        if ref.nbr[bad][k] < 0:
-            raise ValueError("degenerate triangle on the boundary: a vertex lies on a wall")
-        heapq.heappush(maybe, ref._flip(bad, k))
-    return orient_ccw(verts, np.asarray(ref.tri, dtype=np.int64))

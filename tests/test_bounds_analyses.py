@@ -2,7 +2,7 @@
 
 ``python -m headless.held_out`` / ``robustness`` / ``paired`` / ``beside_paper`` on a file
 that is not a store, an empty store, a store with no trials table or without a report end in
-one ``stealth: error:`` line and exit 2 (:func:`headless.failure.guarded`), never a
+one ``stealth: error:`` line and exit 2 (:func:`headless.commands.failure.guarded`), never a
 sqlite3 / FileNotFoundError / ZeroDivisionError traceback.
 """
 

@@ -14,30 +14,28 @@ and screenshots are reproducible.
 
 from __future__ import annotations
 
-import argparse
 import dataclasses
 import gc
 import sys
 import time
-from collections.abc import Callable, Sequence
-from dataclasses import dataclass
+from collections.abc import Callable
 from typing import Any
 
 from game.large.distance_worker import DistanceWorker
 from game.front.camera import Camera
 from game.front.effects import NoiseRings, draw_rain
+from game.front.frame_loop import FrameLoop
 from game.front.layers import COMPOSE_STRIPES
 from game.front.palette import BAD, GOOD, WARN
+from game.front.play_panels import play_panel
+from game.front.play_settings import PlaySettings, SessionSink
 from game.front.render import (
     DrawOptions,
-    FrameLoop,
     Renderer,
     default_window_size,
     init_pygame,
     pygame,
-    save_screenshot,
 )
-from game.errors import FrontError
 from game.front.keys import KEY_HELP, MODE_ORDER
 from navmesh.level import bundled_level_names
 from game.front.screens import Panel
@@ -50,8 +48,6 @@ from game.scene import OVERLAYS, Scene, SceneBuilder, overlay_key
 from game.trial import TrialSpec
 from game.world import World
 
-#: What ``--record`` hands the command line for every finished session: the row and trace.
-SessionSink = Callable[[dict[str, Any], Sequence[str]], None]
 
 #: Guard modes on the number keys, in the order of SPEC §9.
 MODE_KEYS: dict[int, str] = {pygame.K_1 + i: mode for i, mode in enumerate(MODE_ORDER)}
@@ -76,28 +72,6 @@ MAX_STEPS_PER_FRAME = 6
 MESSAGE_SECONDS = 2.5
 
 
-@dataclass(frozen=True)
-class PlaySettings:
-    """Everything that defines a game; the world is rebuilt from it on restart."""
-
-    level: str
-    guards: str = "pf"
-    abstraction: str = "grid"
-    scenario: str = "capture"
-    seed: int = 0
-    overrides: tuple[str, ...] = ()
-    autopilot: str | None = None
-    overlay: str = "none"
-    show_mesh: bool = False
-    show_plans: bool = False
-    #: plugin stimuli, ``"FILE.py:NAME"`` or entry-point names (``--stimulus``)
-    stimuli: tuple[str, ...] = ()
-    #: keep every game as a trial row (``stealth play --record DIR``)
-    record: bool = False
-    #: ask the post-game questionnaire (``--questions``, with ``--record``)
-    questions: bool = False
-    #: the levels N (next level) cycles through
-    playlist: tuple[str, ...] = ()
 
 
 class PlayGame(FrameLoop):
@@ -426,41 +400,7 @@ class PlayGame(FrameLoop):
 
     def panel(self) -> Panel | None:
         """The screen over the map now (ready, questionnaire, game over), if any."""
-        goal = self.goal
-        if self.state == "ready":
-            if goal.has_goal:
-                task = (f"Pick up the {len(goal.collected)} stars, then reach" if len(goal.collected)
-                        else "Reach") + " the green exit without being caught"
-            else:
-                task = f"Survive {self.world.total_steps * self.world.dt:g} s without being caught"
-            return Panel(f"{self.level.name}: ready", (task, "The clock starts on your first move (WASD / arrows)"),
-                         GOOD, hint="N next level · B previous · Esc quit")
-        if self.state == "questions":
-            k = len(self.answers)
-            return Panel("Your view (1-5)", [q for _, q in QUESTIONS], WARN, choice=k,
-                         hint="press 1-5 for the marked question · Enter skip")
-        if self.state == "over":
-            return self._over_panel()
-        return None
-
-    def _over_panel(self) -> Panel:
-        titles = {"won": ("ESCAPED", GOOD), "caught": ("CAUGHT", BAD),
-                  "survived": ("SURVIVED", GOOD), "time up": ("TIME UP", WARN)}
-        title, color = titles.get(self.outcome, (self.outcome.upper(), WARN))
-        hint = "Enter restart · N next level · 1-5 other guards · Esc quit"
-        pending = self.world.m.distances_pending()
-        if pending:  # a large level: the metrics wait for the worker; the window does not
-            return Panel(title, [f"time {self.world.t:.1f} s · the metrics follow in a moment "
-                                 f"({pending} distance searches to go)"], color, hint=hint)
-        m = self.world.metrics()
-        seen = m["first_detect_time"]
-        lines = [f"time {self.world.t:.1f} s · captures {m['captures']} · first seen "
-                 + ("never" if seen is None else f"at {seen:.1f} s")]
-        lines.append(f"mean guard distance {m['avg_guard_player_dist']:.1f} · guard coverage "
-                     f"{100 * m['coverage']:.0f} %"
-                     + (f" · stars {int(self.goal.collected.sum())}/{len(self.goal.collected)}"
-                        if len(self.goal.collected) else ""))
-        return Panel(title, lines, color, hint=hint)
+        return play_panel(self)
 
     def options(self) -> DrawOptions:
         """Display options and HUD texts for this frame."""
@@ -555,90 +495,4 @@ def _freeze_heap() -> None:
     gc.freeze()
 
 
-# ---------------------------------------------------------------------------- command line
-
-
-def lockstep_wanted(frames: int | None) -> bool:
-    """Lockstep (one physics step per frame) with --frames or without a real display."""
-    return frames is not None or pygame.display.get_driver() in ("dummy", "offscreen")
-
-
-def open_display() -> None:
-    """Initialise the display or fail with a one-line user error."""
-    try:
-        init_pygame()
-    except pygame.error as error:
-        raise FrontError(
-            f"cannot open a window ({error}); for a headless run set SDL_VIDEODRIVER=dummy"
-        ) from None
-
-
-def finish(surface: pygame.Surface, screenshot: str | None, times: Sequence[float]) -> None:
-    """Save the screenshot (if asked) and report the frame count and times on stderr."""
-    if screenshot:
-        try:
-            save_screenshot(surface, screenshot)
-        except OSError as error:
-            raise FrontError(f"--screenshot {screenshot}: cannot write ({error})") from None
-    if times:
-        ordered = sorted(times)
-        median = ordered[len(ordered) // 2] * 1000
-        p99 = ordered[min(len(ordered) - 1, int(0.99 * len(ordered)))] * 1000
-        shot = f", screenshot {screenshot}" if screenshot else ""
-        print(f"{len(times)} frames, median {median:.2f} ms, p99 {p99:.2f} ms{shot}", file=sys.stderr)
-
-
-def cmd_play(args: argparse.Namespace, on_session: SessionSink | None = None) -> int:
-    """``stealth play [LEVEL]``: see the module docstring and docs/play.md.
-
-    Without a level a chooser lists the bundled levels. ``on_session`` receives every
-    finished session's row and trace (the command line stores them for ``--record``).
-    """
-    from ai.stimuli import load_stimulus
-    from navmesh.level import load_level
-
-    for plugin in args.stimulus:  # before the level: a plugin may declare its zone kinds
-        load_stimulus(plugin)  # a bad plugin fails here with its one-line message
-    if args.level is not None:
-        load_level(args.level)  # a bad level fails here with its one-line message
-    try:
-        overlay = overlay_key(args.overlay)
-    except ValueError as error:
-        raise FrontError(f"--overlay: {error}") from None
-    if args.frames is not None and args.frames < 1:
-        raise FrontError(f"--frames: expected a positive number of frames, got {args.frames}")
-    from game.config import Config
-
-    Config.load({"world.spawns": "level"}).with_overrides(args.set)  # bad --set: one line
-    open_display()
-    level = args.level
-    if level is None:
-        from game.front.chooser import LevelChooser
-
-        pygame.display.set_caption("Stealthfield")
-        chooser = LevelChooser(pygame.display.set_mode((960, 780)), bundled_level_names(),
-                               mode=args.guards)
-        level = chooser.run()
-        if level is None:
-            pygame.display.quit()
-            return 0
-        args.guards = chooser.mode
-    settings = PlaySettings(
-        level=level, guards=args.guards, abstraction=args.abstraction,
-        scenario=args.scenario, seed=args.seed,
-        overrides=tuple(args.set), autopilot=args.autopilot, overlay=overlay,
-        show_mesh=args.mesh, show_plans=args.plans, stimuli=tuple(args.stimulus),
-        record=on_session is not None, questions=bool(getattr(args, "questions", False)),
-    )
-    game = PlayGame(settings, lockstep=lockstep_wanted(args.frames), on_session=on_session)
-    try:
-        times = game.run(args.frames)
-        finish(game.screen, args.screenshot, times)
-    finally:
-        game.close()
-        pygame.display.quit()
-    return 0
-
-
-__all__ = ["MECHANICS", "MODE_KEYS", "PlayGame", "PlaySettings", "cmd_play"]
-
+__all__ = ["MECHANICS", "MODE_KEYS", "PlayGame", "PlaySettings"]

@@ -25,7 +25,8 @@ import numpy as np
 from game.agents import max_agent_speed
 from game.config import Config
 from game.front.camera import Camera
-from game.front.render import DrawOptions, FrameLoop, Renderer, default_window_size, init_pygame, pygame
+from game.front.frame_loop import FrameLoop
+from game.front.render import DrawOptions, Renderer, default_window_size, init_pygame, pygame
 from game.scene import GuardDrawing, PlayerDrawing, Scene, SceneBuilder
 from game.trace import GuardRecord, Trace, TraceError, TraceLine, load_trace, parse_line
 from game.trial import TrialSpec
@@ -329,7 +330,7 @@ def cmd_replay(args: argparse.Namespace, config: Config | None = None) -> int:
 
     ``config``: the configuration the trace was made with (view range, cone, attack range,
     agent radius); the defaults when not known (a trace file alone does not carry it)."""
-    from game.front.play import finish, lockstep_wanted, open_display
+    from game.front.play_command import finish, lockstep_wanted, open_display
     from game.errors import FrontError as UserError
     from navmesh.graph import graph_for
     from navmesh.level import load_level

@@ -16,7 +16,7 @@ import sys
 from collections.abc import Mapping, Sequence
 from pathlib import Path
 
-from ..failure import GuardedParser, guarded, wants_debug
+from ..commands.failure import GuardedParser, guarded, wants_debug
 from ..outputs.clobber import refuse_inputs_all
 from .markers import replace_marked
 from .paper import paper_table3
@@ -79,7 +79,7 @@ def beside_paper(directory: Path, literal: Path | None = None) -> str:
 
 def main(argv: Sequence[str] | None = None) -> int:
     """``python -m headless.beside_paper``: its exit code; every failure one ``stealth: error:`` line
-    (:func:`headless.failure.guarded`, as for ``stealth``)."""
+    (:func:`headless.commands.failure.guarded`, as for ``stealth``)."""
     words = list(sys.argv[1:] if argv is None else argv)
     return guarded(lambda: _main(words), wants_debug(words))
 

@@ -23,7 +23,7 @@ from pathlib import Path
 from typing import Any
 
 from .reproducible import save_figure
-from ..failure import GuardedParser, guarded, wants_debug
+from ..commands.failure import GuardedParser, guarded, wants_debug
 from .beside_paper import COLUMNS
 from ..outputs.clobber import refuse_inputs_all
 from ..errors import UserError
@@ -207,7 +207,7 @@ def plot_errors(ours: Sequence[Compared], path: Path, title: str) -> None:
 
 def main(argv: Sequence[str] | None = None) -> int:
     """``python -m headless.held_out``: its exit code; every failure one ``stealth: error:`` line
-    (:func:`headless.failure.guarded`, as for ``stealth``)."""
+    (:func:`headless.commands.failure.guarded`, as for ``stealth``)."""
     words = list(sys.argv[1:] if argv is None else argv)
     return guarded(lambda: _main(words), wants_debug(words))
 

@@ -18,7 +18,7 @@ from typing import Any
 
 import numpy as np
 
-from ..failure import GuardedParser, guarded, wants_debug
+from ..commands.failure import GuardedParser, guarded, wants_debug
 from .stats import bootstrap_ci
 from ..store import STORE_NAME, ResultStore
 
@@ -100,7 +100,7 @@ def paired_table(rows: Sequence[Mapping[str, Any]], arm: str = "arm",
 
 def main(argv: Sequence[str] | None = None) -> int:
     """``python -m headless.paired``: its exit code; every failure one ``stealth: error:`` line
-    (:func:`headless.failure.guarded`, as for ``stealth``)."""
+    (:func:`headless.commands.failure.guarded`, as for ``stealth``)."""
     words = list(sys.argv[1:] if argv is None else argv)
     return guarded(lambda: _main(words), wants_debug(words))
 

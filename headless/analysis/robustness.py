@@ -30,7 +30,7 @@ from typing import Any
 import numpy as np
 
 from .reproducible import save_figure
-from ..failure import GuardedParser, guarded, wants_debug
+from ..commands.failure import GuardedParser, guarded, wants_debug
 from ..outputs.clobber import refuse_inputs_all
 from ..errors import UserError
 from .markers import replace_marked
@@ -311,7 +311,7 @@ def write_between_markers(path: Path, text: str) -> None:
 
 def main(argv: Sequence[str] | None = None) -> int:
     """``python -m headless.robustness``: its exit code; every failure one ``stealth: error:`` line
-    (:func:`headless.failure.guarded`, as for ``stealth``)."""
+    (:func:`headless.commands.failure.guarded`, as for ``stealth``)."""
     words = list(sys.argv[1:] if argv is None else argv)
     return guarded(lambda: _main(words), wants_debug(words))
 

@@ -23,7 +23,7 @@ from typing import NoReturn
 
 from navmesh.errors import StealthError
 
-from .errors import UserError
+from ..errors import UserError
 
 __all__ = ["EXIT_INTERRUPTED", "EXIT_USER_ERROR", "GuardedParser", "UsageError", "guarded",
            "os_error_line"]
