@@ -133,6 +133,11 @@ class Counters:
         self.settle()
         return self.dist_sum / self.dist_samples if self.dist_samples else None
 
+    def observe_view(self, guards: Any) -> None:
+        """At an AI tick: the nodes the guards see now count for ``coverage_seen``."""
+        if self.view_cover is not None:
+            self.view_cover.observe(guards)
+
     def count_capture(self, t: float) -> None:
         """The player lost all HP at time ``t``."""
         self.captures += 1

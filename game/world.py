@@ -289,9 +289,8 @@ class World(PlayerActions):
         if self.end_on_capture:
             self.done = True
             return
-        # Fixed-time scenario: full HP again, at a fresh start position (world.respawn) or,
-        # with "stay", where the player stands, still walking its plan. Guards still in range
-        # hurt it from the next step on: the next capture is a second depletion of full HP.
+        # Fixed-time: full HP again, at a fresh start (world.respawn) or, with "stay", where the
+        # player stands; guards still in range deplete the full HP again from the next step.
         self.health.heal()
         node = respawn_node(self.respawn, self.graph, self.guards, self.senses,
                             self.view_range, self.spawn_rng, here=self.player.node)
@@ -307,8 +306,7 @@ class World(PlayerActions):
         self.team.before_tick(self)
         self.tick_events = self.events
         view = self.view()
-        if self.m.view_cover is not None:
-            self.m.view_cover.observe(self.guards)
+        self.m.observe_view(self.guards)
         self.stimuli.tick(view, dt)  # before the guard AI's tick, so FSM reacts to new layers
         self.team.after_stimuli(self)
         if self.guard_sight is not None:

@@ -42,7 +42,7 @@ def test_trace_lines_carry_awareness_role_and_phase_and_parse_back() -> None:
     assert line.guards[seer].awareness == record["guards"][seer]["awareness"]
 
 
-def test_the_meter_is_drawn_below_a_fully_aware_guard() -> None:
+def test_the_mark_over_a_fully_aware_guard_is_a_red_box() -> None:
     pygame.display.init()
     pygame.font.init()
     pygame.display.set_mode((960, 800))
@@ -63,7 +63,9 @@ def test_the_meter_is_drawn_below_a_fully_aware_guard() -> None:
             images.append(pygame.surfarray.array3d(surface))
         x, y = renderer.to_screen(*scene.guards[i].pos)
         radius = max(5.0, scene.agent_radius * renderer.layout.scale)
-        px, py = int(x), int(y + radius + 4)  # below: the state label sits above the guard
+        # the awareness mark sits above the guard: a full one is a red "!" box (its bottom
+        # row, left of the glyph), and without awareness (nor sight) there is none
+        px, py = int(x) - 7, int(y - radius - 8)
         assert tuple(images[0][px, py]) == pytest.approx(BAD, abs=2)
         assert not np.array_equal(images[0][px, py], images[1][px, py])
     finally:
