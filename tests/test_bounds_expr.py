@@ -15,9 +15,9 @@ from pathlib import Path
 import pytest
 
 from headless.cli import main
-from headless.dirlock import DirectoryLock
+from headless.outputs.dirlock import DirectoryLock
 from headless.errors import UserError
-from headless.expr import ExpressionError, parse_constraint, parse_expression
+from headless.tune.expr import ExpressionError, parse_constraint, parse_expression
 
 pytest.importorskip("optuna")
 
@@ -153,7 +153,7 @@ def test_a_full_disk_under_optuna_is_one_line(tmp_path: Path, capsys, monkeypatc
 
 
 def test_a_full_disk_writing_the_outputs_is_one_line(tmp_path: Path, capsys, monkeypatch) -> None:
-    import headless.tune_report as tune_report
+    import headless.tune.report as tune_report
 
     def full(*args, **kwargs):
         raise OSError(errno.ENOSPC, "No space left on device", "best.toml")

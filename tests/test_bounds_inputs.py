@@ -90,7 +90,7 @@ def test_ctrl_c_during_start_up_is_one_line() -> None:
     assert warm.returncode == 0
     for delay in (0.35, 0.6, 1.0):
         process = subprocess.Popen([sys.executable, "-m", "headless.cli", "sim", "maze",
-                                    "--set", "world.duration=60"], env=env, cwd=ROOT,
+                                    "--set", "world.duration=600"], env=env, cwd=ROOT,
                                    stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
         time.sleep(delay)
         process.send_signal(signal.SIGINT)

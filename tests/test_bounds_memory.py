@@ -1,15 +1,15 @@
 """Issue 24 class 6: memory over many trials in one process stays bounded.
 
 Every per-process cache is bounded: the field matrices of one graph are kept for at most
-:data:`ai.fields.MATRICES_PER_GRAPH` parameter sets (a tuner varying ``pf.kernel_lambda``
+:data:`ai.field_matrices.MATRICES_PER_GRAPH` parameter sets (a tuner varying ``pf.kernel_lambda``
 per trial grew ~0.9 MB a trial before), each with byte-bounded row caches. The measurement
 over 2,000 trials is ``benchmarks/memory.py``.
 """
 
 from __future__ import annotations
 
-import ai.fields as fields
-from ai.fields import MATRICES_PER_GRAPH, field_matrices
+import ai.field_matrices as fields
+from ai.field_matrices import MATRICES_PER_GRAPH, field_matrices
 from ai.params import PFParams
 from navmesh.graph import graph_for
 from navmesh.level import load_level

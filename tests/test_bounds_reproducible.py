@@ -1,6 +1,6 @@
 """Issue 24 class 6: ``stealth report`` on the same store twice writes byte-identical files.
 
-Every figure goes through :func:`headless.reproducible.save_figure` (a fixed ``svg.hashsalt``,
+Every figure goes through :func:`headless.analysis.reproducible.save_figure` (a fixed ``svg.hashsalt``,
 no dates): the SVGs, PNGs and every other report file are the same bytes on a second run.
 """
 
@@ -10,7 +10,7 @@ import shutil
 from pathlib import Path
 
 from headless.presets import load_preset
-from headless.report import write_report
+from headless.analysis.report import write_report
 from headless.sweep import run_sweep
 
 PRESET = """

@@ -26,6 +26,16 @@ from game.front.sound import KINDS, SoundBoard
 SIZE = (640, 520)
 
 
+@pytest.fixture(autouse=True)
+def _dummy_audio(monkeypatch: pytest.MonkeyPatch):  # type: ignore[no-untyped-def]
+    """Each test opens SDL's dummy audio device afresh (another test of the same process may
+    have closed the mixer or pointed SDL elsewhere)."""
+    monkeypatch.setenv("SDL_AUDIODRIVER", "dummy")
+    pygame.mixer.quit()
+    yield
+    pygame.mixer.quit()
+
+
 class _CountingSound:
     """Stands in for a mixer Sound: counts the mixer calls made for one kind."""
 

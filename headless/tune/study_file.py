@@ -1,6 +1,6 @@
 """The Optuna study file of ``stealth tune`` (``DIR/study.db``), opened without tracebacks.
 
-A study directory is written by one ``tune`` at a time (:class:`~headless.dirlock.DirectoryLock`
+A study directory is written by one ``tune`` at a time (:class:`~headless.outputs.dirlock.DirectoryLock`
 on ``DIR/results.lock``: a second run on the same directory is refused in one line, and the
 lock goes with its holder's death). A ``study.db`` that is not an SQLite file is refused
 before Optuna opens it, and whatever SQLAlchemy raises later (a full disk, a damaged file)
