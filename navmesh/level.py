@@ -7,14 +7,8 @@ the one per-process level cache; it re-exports the format's names, so
 ``from navmesh.level import Level, load_level, parse_level`` is the one import of a level.
 
 Every problem with a file is reported as a :class:`LevelError` whose message is one line,
-``"<file>: <field>: <problem>"``, so the command line can print it and exit cleanly.
-
->>> level = parse_level({"format": "stealth-level/1", "name": "box",
-...                      "grid": ["...", ".#.", "..."], "guards": [[0.5, 0.5]]})
->>> level.rows, level.cols, int(level.occupancy.sum())
-(3, 3, 8)
->>> level.contains(1.5, 1.5), level.cell_of(2.2, 0.7)
-(False, (0, 2))
+``"<file>: <field>: <problem>"``, so the command line can print it and exit cleanly
+(the format's example is :mod:`navmesh.level_format`'s).
 """
 
 from __future__ import annotations
