@@ -1,44 +1,61 @@
-"""The nodes each guard sees now, for guard modes that patrol by sight (``staleness.model = "view"``).
+"""The nodes the guards see: now, per guard (:class:`GuardSight`), and so far, by any guard
+(:class:`ViewCover`, ``metrics.coverage = "seen"``, SPEC §11).
 
-A node is seen by a guard when a player standing on it would be (:meth:`game.senses.Senses.perceives`):
-within the view range scaled by the node's zone, inside the cone, and no wall of the level
-between the guard and the node's position. Per guard only the nodes within the view range
-are looked at (the grid's window of cells, or a k-d tree of a partition's centroids); the
-range and cone tests are vectorised over them, and the line of sight is one vectorised
-segment-crossing test against the walls whose bounding box meets the view's square (the
-same segments the pymunk space holds). A ray that touches a wall counts as blocked. No
-Python loop runs per node: the cost per guard and tick is O(walls) for the box filter plus
-O(nodes in range × walls in range) for the crossings, whatever the level's size.
+A node is seen by a guard when a player standing on it would be
+(:meth:`game.senses.Senses.perceives`): within the view range scaled by the node's zone,
+inside the cone, and no wall of the level between the guard and the node's position. Per guard only the nodes within the view range
+are looked at (:func:`nodes_within`: the grid's window of cells, or a k-d tree of a
+partition's centroids) and the range and cone tests are vectorised over them
+(:meth:`_NodeView.in_view`, one code for both). No Python loop runs per node for those.
+
+The line of sight is where the two differ, each as its reader needs it:
+
+* :class:`GuardSight` (for guard modes that patrol by sight, ``staleness.model = "view"``)
+  tests every node in view: one vectorised segment-crossing test against the walls whose
+  bounding box meets the view's square (the same segments the pymunk space holds); a ray
+  that touches a wall counts as blocked. Per guard and tick: O(walls) for the box filter
+  plus O(nodes in range × walls in range) for the crossings, whatever the level's size.
+* :class:`ViewCover` only needs the nodes not seen yet. Most of those are occluded, tick
+  after tick: the wall that last blocked a node's ray is kept, and a line it still crosses
+  plainly (no end of either segment within rounding of the other) is blocked without a
+  ray; every other line is the pymunk query the player's sight uses
+  (:meth:`game.senses.Senses.clear_line`), so the metric is that rule exactly.
 """
 
 from __future__ import annotations
 
 import math
 import weakref
-from collections.abc import Sequence
+from collections.abc import Iterable, Sequence
 
 import numpy as np
+import pymunk
 from scipy.spatial import cKDTree
 
 from navmesh.graph import NodeGraph
 
-from .agents import Agent
+from .agents import WALL_QUERY, Agent
 from .senses import RANGE_EPS, Senses
 
-__all__ = ["GuardSight", "nodes_in_square"]
+__all__ = ["GuardSight", "ViewCover", "nodes_within"]
+
+#: a side test within this share of |ray|·|wall| of zero is left to pymunk (rounding)
+_TOLERANCE = 1e-9
 
 #: per graph (graphs are cached and shared by trials): the k-d tree of a partition's nodes
 _TREES: weakref.WeakKeyDictionary[NodeGraph, cKDTree] = weakref.WeakKeyDictionary()
 
 
-def nodes_in_square(graph: NodeGraph, x: float, y: float, radius: float) -> np.ndarray:
-    """Node indices that may lie within ``radius`` of (x, y): a superset (the grid's square
-    window of cells; the partition's k-d tree ball with a little slack)."""
+def nodes_within(graph: NodeGraph, x: float, y: float, radius: float) -> np.ndarray:
+    """Indices of nodes whose position may lie within ``radius`` of (x, y): a superset
+    (the grid's square window of cells; the partition's k-d tree ball with slack)."""
     if graph.cell_node is not None:
         size = graph.cell_size
         rows, cols = graph.cell_node.shape
-        r0, r1 = max(0, math.floor((y - radius) / size)), min(rows - 1, math.floor((y + radius) / size))
-        c0, c1 = max(0, math.floor((x - radius) / size)), min(cols - 1, math.floor((x + radius) / size))
+        r0 = max(0, math.floor((y - radius) / size))
+        r1 = min(rows - 1, math.floor((y + radius) / size))
+        c0 = max(0, math.floor((x - radius) / size))
+        c1 = min(cols - 1, math.floor((x + radius) / size))
         if r0 > r1 or c0 > c1:
             return np.zeros(0, dtype=np.int64)
         window = graph.cell_node[r0:r1 + 1, c0:c1 + 1].ravel()
@@ -53,7 +70,31 @@ def _cross(ux: np.ndarray, uy: np.ndarray, vx: np.ndarray, vy: np.ndarray) -> np
     return ux * vy - uy * vx
 
 
-class GuardSight:
+class _NodeView:
+    """What both readers share: the graph, the cone and, per node, the guards' view range
+    for a player standing there (``reach``: the scenario's range × the node's zone scale)."""
+
+    def __init__(self, graph: NodeGraph, senses: Senses, reach: np.ndarray) -> None:
+        self.graph, self.senses, self.cos_half_fov = graph, senses, senses.cos_half_fov
+        self.reach = np.asarray(reach, dtype=np.float64)
+        self.limit = self.reach + RANGE_EPS
+
+    def in_view(self, near: np.ndarray, x: float | np.ndarray, y: float | np.ndarray,
+                cos: float | np.ndarray, sin: float | np.ndarray
+                ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """:meth:`Senses.perceives` without the line, vectorised over the nodes ``near`` seen
+        from (x, y) facing (cos, sin) (one value, or one per node): ``(keep, points, dx, dy)``,
+        ``keep`` true for the nodes in range (with their zone) and inside the cone."""
+        points = self.graph.positions[near]
+        dx, dy = points[:, 0] - x, points[:, 1] - y
+        d2 = dx * dx + dy * dy
+        d = np.sqrt(d2)
+        keep = (d2 <= self.limit[near] ** 2) & (
+            (d <= 1e-9) | (dx * cos + dy * sin >= self.cos_half_fov * d))
+        return keep, points, dx, dy
+
+
+class GuardSight(_NodeView):
     """Which nodes each guard sees now (:meth:`seen`).
 
     ``reach``: per node, the guards' view range for a player standing there (the scenario's
@@ -69,8 +110,7 @@ class GuardSight:
 
     def __init__(self, graph: NodeGraph, senses: Senses, reach: np.ndarray,
                  walls: np.ndarray) -> None:
-        self.graph, self.cos_half_fov = graph, senses.cos_half_fov
-        self.limit = np.asarray(reach, dtype=np.float64) + RANGE_EPS
+        super().__init__(graph, senses, reach)
         self.bound = float(self.limit.max()) if len(self.limit) else 0.0
         seg = np.asarray(walls, dtype=np.float64).reshape(-1, 4)
         self.ax, self.ay, self.bx, self.by = (np.ascontiguousarray(seg[:, k]) for k in range(4))
@@ -85,15 +125,10 @@ class GuardSight:
     def seen_by(self, pos: tuple[float, float], heading: float) -> np.ndarray:
         """The sorted node indices seen from ``pos`` looking along ``heading`` (radians)."""
         x, y = float(pos[0]), float(pos[1])
-        near = np.sort(nodes_in_square(self.graph, x, y, self.bound))
+        near = np.sort(nodes_within(self.graph, x, y, self.bound))
         if not len(near):
             return near
-        points = self.graph.positions[near]
-        dx, dy = points[:, 0] - x, points[:, 1] - y
-        d2 = dx * dx + dy * dy
-        d = np.sqrt(d2)
-        keep = (d2 <= self.limit[near] ** 2) & (
-            (d <= 1e-9) | (dx * math.cos(heading) + dy * math.sin(heading) >= self.cos_half_fov * d))
+        keep, _, dx, dy = self.in_view(near, x, y, math.cos(heading), math.sin(heading))
         near, dx, dy = near[keep], dx[keep], dy[keep]
         if not len(near):
             return near
@@ -125,3 +160,78 @@ class GuardSight:
             overlap = (np.maximum(ta, tb) >= 0) & (np.minimum(ta, tb) <= 1) & ~point
             meets = np.where(flat, overlap, meets)
         return ~meets.any(axis=1)
+
+
+class ViewCover(_NodeView):
+    """Which nodes any guard's view has covered so far (:attr:`seen`, one bool per node).
+
+    ``reach`` is the guards' view range per node (the scenario's range × the node's zone
+    scale, as for the player standing there).
+    """
+
+    def __init__(self, graph: NodeGraph, senses: Senses, reach: np.ndarray) -> None:
+        super().__init__(graph, senses, reach)
+        self.bound = float(self.reach.max()) if len(self.reach) else 0.0
+        self.seen = np.zeros(graph.n, dtype=bool)
+        #: per node: the wall (index into ``_walls``) that blocked its last ray, or -1
+        self.blocker = np.full(graph.n, -1, dtype=np.int32)
+        walls = [shape for shape in senses.space.shapes if isinstance(shape, pymunk.Segment)]
+        self._wall_index: dict[pymunk.Shape, int] = {shape: i for i, shape in enumerate(walls)}
+        ends = [(*shape.a, *shape.b) for shape in walls]
+        self._walls = np.array(ends, dtype=np.float64).reshape(-1, 4)
+
+    def observe(self, guards: Iterable[Agent]) -> None:
+        """Mark every node an active guard perceives now (one AI tick); the guards' nodes
+        in range are tested together, one array per test."""
+        active = [g for g in guards if g.active]
+        parts = [nodes_within(self.graph, g.pos[0], g.pos[1], self.bound) for g in active]
+        if not parts:
+            return
+        near = np.concatenate(parts)
+        owner = np.repeat(np.arange(len(active)), [len(p) for p in parts])
+        unseen = ~self.seen[near]
+        near, owner = near[unseen], owner[unseen]
+        if not len(near):
+            return
+        pos = np.array([g.pos for g in active], dtype=np.float64)
+        # math's cos and sin, as Senses.perceives takes them (numpy's may differ in a bit)
+        cos = np.array([math.cos(g.heading) for g in active])[owner]
+        sin = np.array([math.sin(g.heading) for g in active])[owner]
+        gx, gy = pos[owner, 0], pos[owner, 1]
+        keep, points, _, _ = self.in_view(near, gx, gy, cos, sin)
+        keep[keep] = ~self._still_blocked(gx[keep], gy[keep], points[keep], near[keep])
+        query, seen, blocker = self.senses.space.segment_query_first, self.seen, self.blocker
+        for k, (px, py), (x, y) in zip(near[keep].tolist(), points[keep].tolist(),
+                                       pos[owner[keep]].tolist()):
+            hit = query((x, y), (px, py), 0.0, WALL_QUERY)
+            if hit is None:
+                seen[k] = True
+            else:
+                blocker[k] = self._wall_index.get(hit.shape, -1)
+
+    def _still_blocked(self, x: np.ndarray, y: np.ndarray, points: np.ndarray,
+                       nodes: np.ndarray) -> np.ndarray:
+        """Per line from (x, y) to a node's point: the wall that last blocked the node's ray
+        plainly crosses it — both ends of each segment strictly on either side of the
+        other, beyond rounding — so the ray would hit a wall too."""
+        wall = self.blocker[nodes]
+        out = np.zeros(len(nodes), dtype=bool)
+        known = np.flatnonzero(wall >= 0)
+        if not len(known):
+            return out
+        ax, ay, bx, by = self._walls[wall[known]].T
+        x, y = x[known], y[known]
+        px, py = points[known, 0], points[known, 1]
+        rx, ry, wx, wy = px - x, py - y, bx - ax, by - ay
+        s_o = wx * (y - ay) - wy * (x - ax)      # the ray's ends against the wall's line
+        s_p = wx * (py - ay) - wy * (px - ax)
+        s_a = rx * (ay - y) - ry * (ax - x)      # the wall's ends against the ray's line
+        s_b = rx * (by - y) - ry * (bx - x)
+        tol = _TOLERANCE * np.hypot(rx, ry) * np.hypot(wx, wy)
+        out[known] = ((s_o * s_p < 0) & (s_a * s_b < 0) & (np.minimum(
+            np.minimum(np.abs(s_o), np.abs(s_p)), np.minimum(np.abs(s_a), np.abs(s_b))) > tol))
+        return out
+
+    def share(self) -> float:
+        """The share of nodes seen so far (0 on an empty graph)."""
+        return float(self.seen.mean()) if len(self.seen) else 0.0

@@ -29,7 +29,7 @@ import numpy as np
 
 if TYPE_CHECKING:
     from .large.distance_worker import DistanceWorker
-    from .view_cover import ViewCover
+    from .guard_sight import ViewCover
     from .world import World
 
 __all__ = ["AGGREGATES", "BACKTRACK_RULES", "COVERAGE_RULES", "Counters", "DISTANCE_RULES",

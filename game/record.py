@@ -46,9 +46,7 @@ def trial_row(world: World, spec: TrialSpec, config: Config, *, key: str,
     ``extra`` values are added to the metrics (the store keeps them as extra metrics).
     """
     return {
-        "key": key,
-        **identity_row(spec, world.level.name),
-        "level_ref": spec.level,
+        **identity_row(spec, world.level.name, key=key),
         "config_hash": config.hash(),
         "metrics": {**world.metrics(), **dict(extra or {})},
         "visits": world.m.visits.tolist(),

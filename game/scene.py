@@ -41,6 +41,7 @@ from navmesh.graph import NodeGraph
 from navmesh.level import Level
 
 from .large.background import lowest_priority
+from .large.policy import bucket_walls
 from .ray_cast import WallBuckets, vision_cone
 
 if TYPE_CHECKING:
@@ -50,8 +51,6 @@ Point = tuple[float, float]
 
 #: Rays per radian of field of view (about one every 1.6°), before the corner rays.
 RAYS_PER_RADIAN = 36.0
-#: Levels with more wall segments than this bucket them for the cones (large levels).
-_BUCKET_MIN_WALLS = 2000
 
 
 # ---------------------------------------------------------------------------- overlays
@@ -345,7 +344,7 @@ class SceneBuilder:
         self._d = walls[:, 1] - walls[:, 0]
         corners = np.unique(walls.reshape(-1, 2), axis=0)
         self._corners = corners
-        self._buckets = WallBuckets(walls, corners) if len(walls) > _BUCKET_MIN_WALLS else None
+        self._buckets = WallBuckets(walls, corners) if bucket_walls(len(walls)) else None
         self._layers: dict[str, tuple[tuple[int, ...], tuple[Any, ...], FieldLayer]] = {}
         self._background = (ThreadPoolExecutor(1, "field-layer", initializer=lowest_priority)
                             if background_fields else None)

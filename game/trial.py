@@ -121,15 +121,20 @@ def make_world(
     )
 
 
-def identity_row(spec: TrialSpec, level_name: str | None = None) -> dict[str, Any]:
-    """The identity part of a trial's row, built from the spec in this one place: the
-    spec's fields (``stimuli`` and ``factors`` only when set), ``level`` the level's name
-    (``level_name``; the spec's level when it is not known, e.g. a trial that failed)."""
+def identity_row(spec: TrialSpec, level_name: str | None = None, *,
+                 key: str | None = None) -> dict[str, Any]:
+    """The identity part of a trial's row, built from the spec in this one place (a
+    trial's row, a failed trial's, a session's; a results store keeps it as it is):
+    ``key`` (the spec's, or ``key``), the spec's fields (``stimuli`` and ``factors`` only
+    when set), ``level`` the level's name (``level_name``; the spec's level when it is not
+    known) and ``level_ref`` the name or path the level was loaded from."""
     return {
+        "key": spec.key if key is None else key,
         **{k: v for k, v in asdict(spec).items() if k not in ("overrides", "stimuli", "factors")},
         **({"stimuli": list(spec.stimuli)} if spec.stimuli else {}),
         **({"factors": dict(spec.factors)} if spec.factors else {}),
         "level": spec.level if level_name is None else level_name,
+        "level_ref": spec.level,
         "overrides": dict(spec.overrides),
     }
 

@@ -21,14 +21,13 @@ from . import trace
 from .actions import ActionParams, PlayerActions, Refused
 from .agents import Agent, Locomotion, build_space
 from .config import Config
-from .guard_sight import GuardSight
+from .guard_sight import GuardSight, ViewCover
 from .health import Health
 from .metrics import Counters, world_metrics
 from .schema import check_level
 from .senses import RANGE_EPS, Senses
 from .spawns import guard_spawn_nodes, level_start_node, respawn_node, start_node
 from .team import TeamRules
-from .view_cover import ViewCover
 from .zones import ZoneMap
 
 SCENARIOS = ("capture", "fixed")

@@ -18,7 +18,7 @@ import sys
 import threading
 import time
 import traceback
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from typing import Any
 
 from game.trial import TrialSpec, identity_row, run_trial
@@ -31,21 +31,23 @@ __all__ = [
 ]
 
 
-def run_one(spec: TrialSpec) -> dict[str, Any]:
-    """Run one trial; a trial that raises becomes a row with ``error`` (the traceback)."""
+def run_one(spec: TrialSpec, level_name: str | None = None) -> dict[str, Any]:
+    """Run one trial; a trial that raises becomes a row with ``error`` (the traceback) and
+    the identity of :func:`~game.trial.identity_row`, ``level`` being ``level_name`` (the
+    level's name, which a failed trial may not have read)."""
     try:
-        row = run_trial(spec)
+        return run_trial(spec)
     except Exception as error:
-        row = {**identity_row(spec),
-               "error": f"{type(error).__name__}: {error}\n{traceback.format_exc(limit=-8)}"[:8000]}
-    row["key"] = spec.key
-    row["level_ref"] = spec.level
-    return row
+        text = f"{type(error).__name__}: {error}\n{traceback.format_exc(limit=-8)}"
+        return {**identity_row(spec, level_name), "error": text[:8000]}
 
 
-def run_batch(specs: Sequence[TrialSpec]) -> list[dict[str, Any]]:
-    """Run a few trials in one task (top-level and picklable: any executor can map it)."""
-    return [run_one(spec) for spec in specs]
+def run_batch(specs: Sequence[TrialSpec], level_names: Mapping[str, str] | None = None
+              ) -> list[dict[str, Any]]:
+    """Run a few trials in one task (top-level and picklable: any executor can map it);
+    ``level_names``: the level's name of each level reference, for the rows of failures."""
+    names = level_names or {}
+    return [run_one(spec, names.get(spec.level)) for spec in specs]
 
 
 class InlineExecutor(cf.Executor):

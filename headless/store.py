@@ -86,6 +86,10 @@ CREATE TABLE IF NOT EXISTS meta (
 );
 """
 
+#: the columns of a row's identity (:func:`game.trial.identity_row`; its ``stimuli`` are in
+#: the key), and those of them kept as JSON (``{}`` for a row without)
+_IDENTITY_COLUMNS: tuple[str, ...] = ("key", "level_ref", *IDENTITY, "overrides", "factors")
+_JSON_IDENTITY: tuple[str, ...] = ("overrides", "factors")
 _HEAD: tuple[str, ...] = ("key", "level", "level_ref", "abstraction", "guards", "player",
                           "scenario", "seed", "root_seed", "overrides", "config_hash")
 _TAIL: tuple[str, ...] = ("extra_metrics", "visits", "attacks", "error", "wall_time",
@@ -236,23 +240,15 @@ class ResultStore:
     def add(self, row: Mapping[str, Any]) -> None:
         """Record one trial row (from :func:`game.trial.run_trial`, or a failure) and commit.
 
-        ``row`` needs the identity fields, ``key`` and ``level_ref``; a failed trial has
-        ``error`` (text) and no metrics. An existing successful row with the same key is
-        kept as it is.
+        The row's identity is the one :func:`game.trial.identity_row` built, kept as it is
+        (its mappings as sorted JSON); a failed trial has ``error`` (text) and no metrics.
+        An existing successful row with the same key is kept as it is.
         """
         metrics = dict(row.get("metrics") or {})
         extra = {k: v for k, v in metrics.items() if k not in self.metric_names}
         values = {
-            "key": row["key"],
-            "level": row["level"],
-            "level_ref": row["level_ref"],
-            "abstraction": row["abstraction"],
-            "guards": row["guards"],
-            "player": row["player"],
-            "scenario": row["scenario"],
-            "seed": int(row["seed"]),
-            "root_seed": int(row.get("root_seed", 0)),
-            "overrides": json.dumps(dict(row.get("overrides") or {}), sort_keys=True),
+            **{c: row[c] for c in _IDENTITY_COLUMNS if c not in _JSON_IDENTITY},
+            **{c: json.dumps(dict(row.get(c) or {}), sort_keys=True) for c in _JSON_IDENTITY},
             "config_hash": row.get("config_hash"),
             **{name: stored_value(metrics.get(name)) for name in self.metric_names},
             "extra_metrics": json.dumps(extra, sort_keys=True) if extra else None,
@@ -261,7 +257,6 @@ class ResultStore:
             "error": row.get("error"),
             "wall_time": row.get("wall_time"),
             "finished_at": _now(),
-            "factors": json.dumps(dict(row.get("factors") or {}), sort_keys=True),
         }
         with self.db:
             self.db.execute(_upsert(self.columns), [values[c] for c in self.columns])

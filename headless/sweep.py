@@ -252,13 +252,11 @@ def _write_estimate(stream: IO[str], preset: Preset, todo: list[TrialSpec], work
                  "on 2 vCPUs; the ETA below then uses the real rate)\n")
 
 
-def _record(rows: Iterable[dict[str, Any]], store: ResultStore, preset: Preset,
-            result: SweepResult, bar: Progress) -> None:
-    names = dict(zip(preset.levels, preset.level_names))
+def _record(rows: Iterable[dict[str, Any]], store: ResultStore, result: SweepResult,
+            bar: Progress) -> None:
     finished = failed = 0
     for row in rows:
         if row.get("error"):
-            row["level"] = names.get(row["level_ref"], row["level"])
             failed += 1
             if result.first_error is None:
                 result.first_error = f"{row['key']}: {row['error'].splitlines()[0]}"
@@ -282,6 +280,7 @@ def _drive(executor: cf.Executor, batches: Iterator[list[TrialSpec]], in_flight:
            store: ResultStore, preset: Preset, result: SweepResult, bar: Progress) -> None:
     """Keep at most ``in_flight`` tasks submitted; commit every result as it arrives."""
     pending: dict[cf.Future[Any], list[TrialSpec]] = {}
+    names = dict(zip(preset.levels, preset.level_names))  # for the rows of failed trials
 
     def collect(future: cf.Future[Any]) -> None:
         pending.pop(future)
@@ -290,7 +289,7 @@ def _drive(executor: cf.Executor, batches: Iterator[list[TrialSpec]], in_flight:
             # run_batch never raises for a failing trial, so this is the machinery: a
             # worker process died, the cluster cannot import the project, pickling failed.
             raise _TaskError(error)
-        _record(future.result(), store, preset, result, bar)
+        _record(future.result(), store, result, bar)
 
     try:
         exhausted = False
@@ -300,7 +299,7 @@ def _drive(executor: cf.Executor, batches: Iterator[list[TrialSpec]], in_flight:
                 if batch is None:
                     exhausted = True
                     break
-                pending[executor.submit(run_batch, batch)] = batch
+                pending[executor.submit(run_batch, batch, names)] = batch
             if not pending:
                 break
             done, _ = cf.wait(list(pending), timeout=1.0, return_when=cf.FIRST_COMPLETED)

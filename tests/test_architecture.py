@@ -51,13 +51,14 @@ def _is_type_checking(test: ast.expr) -> bool:
         isinstance(test, ast.Attribute) and test.attr == "TYPE_CHECKING")
 
 
-def _walk_running(tree: ast.AST):  # type: ignore[no-untyped-def]
-    """Every node of ``tree`` except the bodies of ``if TYPE_CHECKING:`` blocks."""
+def _walk_running(tree: ast.AST, type_checking: bool = False):  # type: ignore[no-untyped-def]
+    """Every node of ``tree`` except the bodies of ``if TYPE_CHECKING:`` blocks (those too
+    with ``type_checking``)."""
     stack = [tree]
     while stack:
         node = stack.pop()
         yield node
-        if isinstance(node, ast.If) and _is_type_checking(node.test):
+        if not type_checking and isinstance(node, ast.If) and _is_type_checking(node.test):
             stack.extend(node.orelse)
             continue
         stack.extend(ast.iter_child_nodes(node))
@@ -68,13 +69,15 @@ def _modules() -> frozenset[str]:
     return frozenset(_module_name(p) for p in _files())
 
 
-def imports(path: Path, source: str | None = None, package: str | None = None) -> list[str]:
+def imports(path: Path, source: str | None = None, package: str | None = None, *,
+            type_checking: bool = False) -> list[str]:
     """The modules ``path`` imports at any depth (``from P import m`` names ``P.m`` when that
-    is a module of ours), ``TYPE_CHECKING`` blocks excepted."""
+    is a module of ours), ``TYPE_CHECKING`` blocks excepted unless ``type_checking``
+    (tests/test_layering.py counts those too)."""
     tree = ast.parse(source if source is not None else path.read_text(encoding="utf-8"))
     package = _package_of(path) if package is None else package
     found: list[str] = []
-    for node in _walk_running(tree):
+    for node in _walk_running(tree, type_checking):
         if isinstance(node, ast.Import):
             found += [alias.name for alias in node.names]
         elif isinstance(node, ast.ImportFrom):

@@ -148,9 +148,9 @@ def test_camera_follows_zooms_and_the_static_layer_is_cached() -> None:
 
 
 def test_wall_buckets_cast_the_same_cones(monkeypatch: pytest.MonkeyPatch) -> None:
-    import game.scene
+    import game.large.policy
 
-    monkeypatch.setattr(game.scene, "_BUCKET_MIN_WALLS", 10)  # buckets on a small level too
+    monkeypatch.setattr(game.large.policy, "BUCKET_MIN_WALLS", 10)  # buckets on a small level too
     level = parse_level(building_level(60, 80))
     builder = SceneBuilder(level, graph_for(level, "grid"), view_range=8.0, fov_deg=90.0)
     assert builder._buckets is not None

@@ -11,39 +11,19 @@
 
 from __future__ import annotations
 
-import ast
 from pathlib import Path
 
 import pytest
+from test_architecture import imports  # the one import walker of the suite
 
 ROOT = Path(__file__).resolve().parents[1]
 OURS = ("navmesh", "ai", "game", "headless")
 
 
-def _imports(path: Path, package: str | None = None) -> list[tuple[str, bool]]:
-    """``(module, at_module_level)`` of every import in ``path`` (relative ones resolved
-    against ``package``, by default the package the file lies in)."""
-    tree = ast.parse(path.read_text(encoding="utf-8"), str(path))
-    if package is None:
-        package = ".".join(path.relative_to(ROOT).with_suffix("").parts[:-1])
-    top_level = {id(node) for node in tree.body}
-    for node in tree.body:  # imports under `if TYPE_CHECKING:` / try at module level count too
-        if isinstance(node, (ast.If, ast.Try)):
-            top_level |= {id(n) for n in ast.walk(node)}
-    found = []
-    for node in ast.walk(tree):
-        if isinstance(node, ast.Import):
-            names = [alias.name for alias in node.names]
-        elif isinstance(node, ast.ImportFrom):
-            if node.level:
-                base = package.split(".")[: len(package.split(".")) - node.level + 1]
-                names = [".".join(base + ([node.module] if node.module else []))]
-            else:
-                names = [node.module or ""]
-        else:
-            continue
-        found += [(name, id(node) in top_level) for name in names]
-    return found
+def _imports(path: Path) -> list[str]:
+    """Every module ``path`` imports, at any depth, imports under ``if TYPE_CHECKING:``
+    included (stricter than tests/test_architecture.py: not even a type may cross)."""
+    return imports(path, type_checking=True)
 
 
 def _files(package: str) -> list[Path]:
@@ -57,7 +37,7 @@ def _root(module: str) -> str:
 def _violations(package: str, allowed: set[str]) -> list[str]:
     bad = []
     for path in _files(package):
-        for module, _ in _imports(path):
+        for module in _imports(path):
             if _root(module) in OURS and _root(module) not in allowed:
                 bad.append(f"{path.relative_to(ROOT)} imports {module}")
     return bad
@@ -81,7 +61,7 @@ def test_game_core_never_imports_pygame_headless_the_front_end_or_the_environmen
         rel = path.relative_to(ROOT)
         if rel.parts[1] in ("front", "env"):
             continue
-        for module, _ in _imports(path):
+        for module in _imports(path):
             if _root(module) in ("pygame", "headless") or _under(module, "game.front") or (
                     _under(module, "game.env")):
                 bad.append(f"{rel} imports {module}")
@@ -90,25 +70,27 @@ def test_game_core_never_imports_pygame_headless_the_front_end_or_the_environmen
 
 def test_game_front_imports_nothing_of_headless_or_the_environments() -> None:
     bad = [f"{path.relative_to(ROOT)} imports {module}"
-           for path in _files("game/front") for module, _ in _imports(path)
+           for path in _files("game/front") for module in _imports(path)
            if _root(module) == "headless" or _under(module, "game.env")]
     assert bad == []
 
 
 def test_the_environments_import_nothing_of_headless_nor_pygame() -> None:
     bad = [f"{path.relative_to(ROOT)} imports {module}"
-           for path in _files("game/env") for module, _ in _imports(path)
+           for path in _files("game/env") for module in _imports(path)
            if _root(module) in ("headless", "pygame")]
     assert bad == []
 
 
 @pytest.mark.parametrize("source, expected", [
-    ("from .errors import X", ("game.errors", True)),
-    ("def f():\n    from game.front import render", ("game.front", False)),
-    ("import pygame", ("pygame", True)),
+    ("from .errors import X", ["game.errors"]),
+    ("def f():\n    from game.front import render", ["game.front.render"]),
+    ("import pygame", ["pygame"]),
+    ("from typing import TYPE_CHECKING\nif TYPE_CHECKING:\n    import headless\n",
+     ["typing", "headless"]),
 ])
-def test_the_checker_sees_relative_and_lazy_imports(tmp_path: Path, source: str,
-                                                    expected: tuple[str, bool]) -> None:
+def test_the_checker_sees_relative_lazy_and_type_only_imports(tmp_path: Path, source: str,
+                                                               expected: list[str]) -> None:
     probe = tmp_path / "probe.py"
     probe.write_text(source, encoding="utf-8")
-    assert expected in _imports(probe, "game")
+    assert sorted(imports(probe, package="game", type_checking=True)) == sorted(expected)

@@ -19,7 +19,7 @@ import pytest
 from game.config import Config
 from game.metrics import RECENT_ENTRIES, Counters
 from game.trial import TrialSpec, make_world, run_trial
-from game.view_cover import ViewCover, nodes_within
+from game.guard_sight import ViewCover, nodes_within
 from headless.analysis.report import write_report
 from headless.store import STORE_NAME, ResultStore
 from headless.presets import load_preset

@@ -11,7 +11,7 @@ from pathlib import Path
 import pytest
 
 from game.metrics import Metric, metric_names, register_metric, unregister_metric
-from game.trial import TrialSpec
+from game.trial import TrialSpec, identity_row
 from headless.analysis.figures import aggregate_figure, layout
 from headless.analysis.report import table_columns, table_rows, write_report
 from headless.store import ResultStore
@@ -107,8 +107,7 @@ def test_layout_has_a_cell_for_every_panel_and_the_legend() -> None:
 
 def _row(seed: int, **extra: object) -> dict:
     spec = TrialSpec("maze", "grid", "cheat", "evade", "fixed", seed)
-    return {"key": spec.key, "level": "maze", "level_ref": "maze", "abstraction": "grid",
-            "guards": "cheat", "player": "evade", "scenario": "fixed", "seed": seed,
+    return {**identity_row(spec),
             "metrics": {"captured": False, "capture_time": None, "captures": 0,
                         "coverage": 0.5, "avg_guard_player_dist": 2.0,
                         "first_detect_time": None, "backtracks": 1, **extra},

@@ -11,7 +11,7 @@ from typing import Any
 import numpy as np
 import pytest
 
-from game.trial import TrialSpec
+from game.trial import TrialSpec, identity_row
 from headless.cli import main
 from headless.analysis.report import (
     BOOTSTRAP_RESAMPLES,
@@ -177,9 +177,7 @@ def _add(store: ResultStore, n_nodes: int, guards: str, scenario: str, seed: int
          **metrics: Any) -> None:
     spec = TrialSpec("maze", "grid", guards, "maxmin", scenario, seed)
     store.add({
-        "key": spec.key, "level": "maze", "level_ref": "maze", "abstraction": "grid",
-        "guards": guards, "player": "maxmin", "scenario": scenario, "seed": seed,
-        "config_hash": "x", "wall_time": 0.5,
+        **identity_row(spec), "config_hash": "x", "wall_time": 0.5,
         "metrics": {"captured": False, "capture_time": None, "captures": 0, "coverage": 0.0,
                     "avg_guard_player_dist": None, "first_detect_time": None, "backtracks": 0,
                     **metrics},
@@ -246,8 +244,7 @@ def test_failed_trials_are_listed(tmp_path: Path) -> None:
     n_nodes = graph_for(load_level("maze"), "grid").n
     with ResultStore(tmp_path / "results.sqlite") as store:
         _add(store, n_nodes, "pf", "capture", 0, captured=True, capture_time=3.0)
-        store.add({"key": "k", "level": "maze", "level_ref": "maze", "abstraction": "grid",
-                   "guards": "pf", "player": "maxmin", "scenario": "fixed", "seed": 1,
+        store.add({**identity_row(TrialSpec("maze", "grid", "pf", "maxmin", "fixed", 1), key="k"),
                    "error": "RuntimeError: boom\nTraceback ..."})
     write_report(tmp_path, figures=False)
     (failed,) = read(tmp_path / "failed.csv")

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import csv
 import io
+import json
 import os
 import signal
 import sqlite3
@@ -15,7 +16,7 @@ from typing import Any
 
 import pytest
 
-from game.trial import TrialSpec
+from game.trial import TrialSpec, identity_row
 from headless import executors
 from headless.cli import main
 from headless.analysis.report import write_report
@@ -167,8 +168,7 @@ def test_unknown_preset_name_lists_bundled(capsys: pytest.CaptureFixture[str],
 # ------------------------------------------------------------------------- store
 def test_store_never_duplicates_and_retries_failures(tmp_path: Path) -> None:
     spec = TrialSpec("maze", "grid", "cheat", "evade", "capture", 0)
-    base = {"key": spec.key, "level": "maze", "level_ref": "maze", "abstraction": "grid",
-            "guards": "cheat", "player": "evade", "scenario": "capture", "seed": 0}
+    base = identity_row(spec)
     good = {**base, "metrics": {"captured": True, "capture_time": 3.5, "captures": 1,
                                 "coverage": 0.5, "avg_guard_player_dist": 2.0,
                                 "first_detect_time": 1.0, "backtracks": 2},
@@ -281,6 +281,42 @@ def test_failed_trial_is_recorded_the_sweep_goes_on_and_a_rerun_retries_it(
     assert "2 finished, 0 failed, 6 skipped" in capsys.readouterr().err
     with ResultStore(out / "results.sqlite", readonly=True) as store:
         assert store.count() == (8, 0)
+
+
+def test_a_stored_rows_identity_is_the_specs_identity_row_failed_or_not(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str],
+) -> None:
+    """A level file whose name is not its path: every stored row, a failure's too, has the
+    level's name and the reference it was loaded from, as identity_row builds them."""
+    level = json.loads((ROOT / "assets" / "levels" / "maze.json").read_text())
+    level["name"] = "renamed-maze"
+    (tmp_path / "my-level.json").write_text(json.dumps(level))
+    preset_path = tmp_path / "file.toml"
+    preset_path.write_text(TINY.format(seeds=1, duration=3.0).replace(
+        'levels = ["maze"]', 'levels = ["my-level.json"]').replace(
+        '"world.duration"', '"pf.rho" = 0.9\n"world.duration"'))
+    real = executors.run_trial
+
+    def flaky(spec: TrialSpec) -> dict[str, Any]:
+        if spec.guards == "random":
+            raise RuntimeError("simulated crash")
+        return real(spec)
+
+    monkeypatch.setattr(executors, "run_trial", flaky)
+    out = tmp_path / "out"
+    assert main(["run", "--preset", str(preset_path), "--out", str(out), "--workers", "1"]) == 1
+    capsys.readouterr()
+    with ResultStore(out / "results.sqlite", readonly=True) as store:
+        stored = [*store.trials(), *store.trials(failed=True)]
+    assert len(stored) == 4 and sum(1 for t in stored if t["error"]) == 2
+    for trial in stored:
+        spec = TrialSpec(trial["level_ref"], trial["abstraction"], trial["guards"],
+                         trial["player"], trial["scenario"], trial["seed"],
+                         tuple(sorted(trial["overrides"].items())), trial["root_seed"])
+        expected = identity_row(spec, "renamed-maze")
+        assert {k: trial[k] for k in expected} == expected
+        assert trial["level_ref"] == str(tmp_path / "my-level.json")
+        assert trial["factors"] == {}
 
 
 def test_ctrl_c_keeps_committed_trials_and_says_how_to_resume(

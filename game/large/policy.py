@@ -4,7 +4,9 @@ On a graph that keeps dense distances (every bundled level) everything is comput
 frame. On one that searches per source (:mod:`navmesh.distances`), the front end computes
 the whole-field overlay on a background thread, composes new field values over a few frames
 and hands the distance metric's searches to a worker process (:mod:`game.large.distance_worker`).
-None of it changes a value, only when it is computed.
+The vision cones of a level with many wall segments test each ray against the walls of the
+cells it crosses (:class:`game.ray_cast.WallBuckets`) instead of against all of them
+(:func:`bucket_walls`). None of it changes a value, only when it is computed.
 """
 
 from __future__ import annotations
@@ -13,7 +15,19 @@ from dataclasses import dataclass
 
 from navmesh.graph import NodeGraph
 
-__all__ = ["SizePolicy"]
+__all__ = ["BUCKET_MIN_WALLS", "SizePolicy", "bucket_walls"]
+
+#: Levels with more wall segments than this bucket them for the vision cones.
+BUCKET_MIN_WALLS = 2000
+
+
+def bucket_walls(n_walls: int) -> bool:
+    """Whether the cones of a level with ``n_walls`` wall segments bucket them by cell.
+
+    >>> bucket_walls(2000), bucket_walls(2001)
+    (False, True)
+    """
+    return n_walls > BUCKET_MIN_WALLS
 
 
 @dataclass(frozen=True)
