@@ -8,7 +8,7 @@ candidate set; ``explain`` says why, in plain JSON-able types.
 from __future__ import annotations
 
 from collections import deque
-from collections.abc import Callable, Hashable, Mapping
+from collections.abc import Callable, Hashable, Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any
 
@@ -227,9 +227,15 @@ class PotentialFieldGuards(GuardAI):
         """Current I, I_extra, C, N, P, K arrays (read-only), for the game overlay."""
         return self.field.fields()
 
-    def prepare(self, budget: float) -> None:
+    def prepare(self, budget: float) -> bool:
         """The guards' next nodes' spreads ahead, for about ``budget`` s (:meth:`Prefetch.run`)."""
-        self.prefetch.run(budget)
+        return self.prefetch.run(budget)
+
+    def expect(self, nodes: Sequence[int]) -> None:
+        """The confidence balls of ``nodes`` first in the work-ahead queue: the next tick
+        deposits from the guards' nodes, and every decision reads its teammates' balls."""
+        for node in nodes:
+            self.prefetch.expect(int(node), urgent=True)
 
     def fields_later(self) -> tuple[Hashable, Callable[[], dict[str, np.ndarray]]]:
         """The field's state now (:meth:`CompositeField.snapshot`): nothing computed until called."""

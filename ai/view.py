@@ -157,10 +157,17 @@ class GuardAI(ABC):
         """
         return {}
 
-    def prepare(self, budget: float) -> None:
-        """Spare time of about ``budget`` seconds (the game calls it after a quick frame): a
+    def prepare(self, budget: float) -> bool:
+        """Spare time of about ``budget`` seconds (the game calls it after each frame): a
         mode may work ahead here, such as cache entries a coming decision will read; never
-        anything that changes a result. Nothing by default."""
+        anything that changes a result. Returns whether work ahead is left (the game then
+        gives more). Nothing by default."""
+        return False
+
+    def expect(self, nodes: Sequence[int]) -> None:
+        """The guards will soon stand on ``nodes`` (the game's guess: each guard's node and
+        target, passed when they change): a mode that works ahead in :meth:`prepare` may put
+        what its next tick reads there first. Never changes a result; nothing by default."""
 
     def fields_later(self) -> tuple[Hashable, Callable[[], dict[str, np.ndarray]]]:
         """:meth:`fields` as they are now, to compute later and on another thread: an

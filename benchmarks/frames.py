@@ -35,7 +35,8 @@ following the player and the minimap: what a frame costs besides ``world.step()`
 Each frame is what ``stealth play`` does once per frame in lockstep: events, one physics
 step (``world.step()``, 1/60 s, with the AI's decisions and its 1-s tick), the scene
 (cones ray-cast against the walls, plans, field layer) and the pygame drawing, plus the
-display flip, then the guard AI's work ahead when the frame ended early. Guards are ``pf``
+display flip, then the guard AI's work ahead in the budget the frame's measured cost leaves
+(``game/front/frame_budget.py``). Guards are ``pf``
 (the only mode with fields), the player on the paper level is the MaxMin autopilot, and by
 default the navmesh/grid lines and the guards' plans are shown too, so
 this is the busiest picture the game draws. The first ``--warmup`` frames (world

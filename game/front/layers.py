@@ -15,6 +15,7 @@ overlay.
 
 from __future__ import annotations
 
+import time
 from collections.abc import Callable
 from dataclasses import dataclass
 
@@ -88,7 +89,13 @@ class StaticLayers:
 
     def __init__(self, static: StaticScene, stripes: int = 1) -> None:
         self.static = static
+        #: whether new values of a field are composed in stripes (a large level)
+        self.striped = int(stripes) > 1
+        #: how many stripes the next new field values are composed in (the game sets it
+        #: from its frame budget; a compose under way keeps the count it started with)
         self.stripes = max(1, int(stripes))
+        #: the seconds the last composition of the whole region took (measured)
+        self.compose_cost = 0.0
         outline, *holes = static.floor
         self._outline, self._holes = outline, holes
         self._hole_boxes = _bboxes(holes)
@@ -108,8 +115,8 @@ class StaticLayers:
         self._mesh: pygame.Surface | None = None
         self._composite: pygame.Surface | None = None
         self._composite_key: tuple[object, bool] | None = None
-        #: a composite being built in stripes: (its layer, surface, next stripe)
-        self._next: tuple[FieldLayer | None, pygame.Surface, int] | None = None
+        #: a composite being built in stripes: (its layer, surface, next stripe, stripes)
+        self._next: tuple[FieldLayer | None, pygame.Surface, int, int] | None = None
         self._layer: FieldLayer | None = None
         self._pool: dict[str, pygame.Surface] = {}
         self._outline_shape = shapely.Polygon(outline) if len(outline) >= 3 else None
@@ -127,7 +134,7 @@ class StaticLayers:
                    or show_mesh != self._composite_key[1]
                    or _layer_key(layer) != _layer_key(self._layer))  # a toggle shows at once
         if at_once or key != self._composite_key or layer is not self._layer:
-            self._compose(layer, show_mesh, at_once or self.stripes == 1)
+            self._compose(layer, show_mesh, at_once or not self.striped)
         assert self._composite is not None
         return self._composite, self.region
 
@@ -142,22 +149,23 @@ class StaticLayers:
         :meth:`surface` returns (the old one is shown until then; with one stripe the
         composite is drawn onto directly).
 
-        New values of the same field (once per AI tick) come in stripes when ``stripes`` > 1
-        (the game on a large level, where composing the region costs a frame ~10 ms, a stripe
-        a quarter of it); anything else, and every small level, at once, so a rendered scene
+        New values of the same field (once per AI tick) come in :attr:`stripes` stripes when
+        the layers are :attr:`striped` (the game on a large level, where composing the region
+        costs a frame ~10 ms; the game sets the count from its frame budget); anything else, and every small level, at once, so a rendered scene
         shows its own layer. The spare is copied, not swapped with the composite: the line
         layer is RLE-encoded for the one surface it is blitted onto, and SDL encodes it again
         for every other (measured: 13 ms at 10^6 cells).
         """
         if at_once or self._next is None or self._next[0] is not layer:
             # without stripes the composite itself is the one surface drawn onto (no copy)
-            spare = self._blank("composite-next" if self.stripes > 1 else "composite")
-            self._next = (layer, spare, 0)
-        _, spare, stripe = self._next
-        done = self.stripes if at_once else stripe + 1
+            spare = self._blank("composite-next" if self.striped else "composite")
+            self._next = (layer, spare, 0, 1 if at_once else max(1, int(self.stripes)))
+        _, spare, stripe, stripes = self._next
+        done = stripes if at_once else stripe + 1
         width, height = spare.get_size()
-        top = height * stripe // self.stripes
-        spare.set_clip(pygame.Rect(0, top, width, height * done // self.stripes - top))
+        top = height * stripe // stripes
+        started = time.perf_counter()
+        spare.set_clip(pygame.Rect(0, top, width, height * done // stripes - top))
         spare.blit(self._base_surface(), (0, 0))
         if layer is not None:
             self._draw_field(spare, layer.norm)
@@ -169,8 +177,10 @@ class StaticLayers:
             self._lines = self._keyed(self._draw_lines)
         spare.blit(self._lines, (0, 0))
         spare.set_clip(None)
-        if done < self.stripes:
-            self._next = (layer, spare, done)
+        if height * (done - stripe) // stripes:  # the whole region's cost, from this part
+            self.compose_cost = (time.perf_counter() - started) * stripes / (done - stripe)
+        if done < stripes:
+            self._next = (layer, spare, done, stripes)
             return
         composite = self._blank("composite")
         if composite is not spare:

@@ -40,6 +40,7 @@ from game.front.keys import KEY_HELP, MODE_ORDER
 from navmesh.level import bundled_level_names
 from game.front.screens import Panel
 from game.front.sound import SoundBoard
+from game.front.work_ahead import WorkAhead
 from game.front.best import BestResults
 from game.large.policy import SizePolicy
 from game.objectives import Objectives
@@ -114,6 +115,8 @@ class PlayGame(FrameLoop):
         #: the game ended, recording, before the distance searches were done: store then
         self._store_when_ready = False
         self.sound = SoundBoard()
+        #: the frame's extra work, sized by its measured budget (see :meth:`frame`)
+        self.work = WorkAhead()
         self.best = BestResults()
         self._load(settings.level, settings.guards)
         _freeze_heap()
@@ -436,10 +439,12 @@ class PlayGame(FrameLoop):
     def frame(self, elapsed: float = 0.0) -> None:
         """One frame: events, world update, drawing, display flip, then work ahead.
 
-        A frame that took less than :data:`WORK_AHEAD_UNTIL` lets the guard AI use the rest
-        of it (:meth:`~ai.view.GuardAI.prepare`): on a large level the spreads of the nodes
-        the guards head for are searched there, a ring at a time, instead of inside the
-        next tick or decision. It changes no result, only when the work is done.
+        The frame's fixed part (all but the work ahead) is timed into :attr:`work`'s budget
+        (:class:`~game.front.frame_budget.FrameBudget`), which says how long the guard AI
+        may then work ahead (:meth:`~ai.view.GuardAI.prepare`: on a large level the spreads
+        of the nodes the guards stand on and head for are searched there, a ring at a time,
+        instead of inside the next tick or decision) and how many frames a large level's
+        new field values are composed over. It changes no result, only when work is done.
         """
         start = time.perf_counter()
         for event in pygame.event.get():
@@ -447,14 +452,13 @@ class PlayGame(FrameLoop):
         if not self.running:
             return
         self.update(elapsed)
+        self.work.before_draw(self.renderer.layers)
         scene = self.draw()
         if self.state == "playing" and not self.paused:
             self.sound.observe(self.world, scene.detected, scene.phase,
                                [g.awareness for g in scene.guards])
         pygame.display.flip()
-        spare = WORK_AHEAD_UNTIL - (time.perf_counter() - start)
-        if spare > 0 and not self.idle():
-            self.world.guard_ai.prepare(spare)
+        self.work.after_frame(self.world, time.perf_counter() - start, self.idle())
 
     def settle_view(self) -> None:
         """Draw the current moment until the picture shows all of it — on a large level the
@@ -479,9 +483,6 @@ class PlayGame(FrameLoop):
             self._distances.close()
             self._distances = None
 
-
-#: Seconds into a frame up to which the guard AI may work ahead (half a 60 Hz frame).
-WORK_AHEAD_UNTIL = 0.008
 
 
 def _freeze_heap() -> None:

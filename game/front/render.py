@@ -30,6 +30,7 @@ from game.scene import GuardDrawing, Scene, StaticScene
 from .display import choose_video_driver
 from .draw_options import DrawOptions, Layout
 from .camera import MIN_FIT_SCALE, START_SCALE, Camera
+from .cones import draw_cones
 from .labels import place_labels
 from .layers import StaticLayers
 from .minimap import Minimap
@@ -37,7 +38,7 @@ from .marks import (
     awareness_fill, draw_awareness_mark, draw_phase_ring, draw_player_halo, mark_font,
 )
 from .palette import (
-    ATTACK_RING, BACKGROUND, BAD, EXIT_EDGE, COLLECTIBLE, CONE, CONE_EDGE, CONE_SEEING, CONE_SEEING_EDGE,
+    ATTACK_RING, BACKGROUND, BAD, EXIT_EDGE, COLLECTIBLE,
     GOOD, GUARD, GUARD_ALERT, GUARD_DOWN, HALO, MARKER, PLAN_COLORS, PLAYER, PLAYER_SPRINT,
     TEXT, TEXT_DIM, WARN, Color, colormap_lut, colors_of,
 )
@@ -176,8 +177,7 @@ class Renderer:
             self._diamond(surface, self.to_screen(x, y), max(6, s * 0.35), MARKER, 0)
         for x, y in options.collectibles:
             self._collectible(surface, self.to_screen(x, y), max(6.0, s * 0.35))
-        for guard in scene.guards:
-            self._draw_cone(surface, guard)
+        draw_cones(surface, scene.guards, self.layout)
         for ring in self.static.exits:
             x, y = self.to_screen(float(ring[:, 0].min()), float(ring[:, 1].min()))
             label = self._text("EXIT", self.small, EXIT_EDGE)
@@ -207,26 +207,6 @@ class Renderer:
         if options.paused:  # over any screen: a paused ready screen must not look frozen
             where = "corner" if options.panel is None else "bottom-left"
             draw_panel(surface, area, Panel("PAUSED", ("Space to continue",), BAD, where=where))
-
-    def _draw_cone(self, surface: pygame.Surface, guard: GuardDrawing) -> None:
-        if not guard.active or len(guard.cone) < 3:
-            return
-        s, (ox, oy) = self.layout.scale, self.layout.origin
-        pts = guard.cone * s + (ox, oy)
-        lo = np.floor(pts.min(axis=0)).astype(int)
-        hi = np.ceil(pts.max(axis=0)).astype(int) + 1
-        area = self.layout.world_rect
-        if hi[0] < area.left or hi[1] < area.top or lo[0] > area.right or lo[1] > area.bottom:
-            return  # off screen
-        size = (max(1, hi[0] - lo[0]), max(1, hi[1] - lo[1]))
-        layer = pygame.Surface(size, pygame.SRCALPHA)
-        local = (pts - lo).tolist()
-        pygame.draw.polygon(layer, CONE_SEEING if guard.sees_player else CONE, local)
-        surface.blit(layer, (int(lo[0]), int(lo[1])))
-        edge = CONE_SEEING_EDGE if guard.sees_player else CONE_EDGE
-        outline = pts.tolist()
-        pygame.draw.lines(surface, HALO, True, outline, 4)
-        pygame.draw.lines(surface, edge, True, outline, 2)
 
     def _draw_plan(self, surface: pygame.Surface, guard: GuardDrawing, color: Color) -> None:
         if not guard.active:
