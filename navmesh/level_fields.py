@@ -159,12 +159,14 @@ def _parse_polygon(value: Any, src: str, field: str) -> Polygon:
     """A simple polygon from a list of points (closing point optional)."""
     if not isinstance(value, _ARRAY_TYPES):
         _fail(src, field, f"expected a polygon (an array of [x, y] points), got {_describe(value)}")
-    if len(value) > MAX_POLYGON_VERTICES:
+    if len(value) > MAX_POLYGON_VERTICES + 1:  # before reading a point (+1: a closing point)
         _fail(src, field, f"polygon of {len(value)} points, more than the limit of {MAX_POLYGON_VERTICES}")
     points = [_point(p, src, f"{field}[{i}]") for i, p in enumerate(value)]
     ring = [p for i, p in enumerate(points) if i == 0 or p != points[i - 1]]
     if len(ring) > 1 and ring[0] == ring[-1]:
         ring.pop()
+    if len(ring) > MAX_POLYGON_VERTICES:
+        _fail(src, field, f"polygon of {len(ring)} points, more than the limit of {MAX_POLYGON_VERTICES}")
     distinct = len(set(ring))
     if distinct < 3:
         _fail(src, field, f"polygon needs at least 3 distinct points, got {distinct}")
