@@ -2,7 +2,9 @@
 
 Writes the levels of the issue into a temporary folder — a 1000 × 1000 grid of pillars
 (250,000 holes), an outline of 10^5 vertices, a 10^5-vertex obstacle, and 10^5 outline
-vertices with 10^4 obstacles — and times ``stealth validate`` (and, with ``--levels``,
+vertices with 10^4 obstacles (the last three refused by the loader's limit of 10^4 points a
+polygon), and the same at that limit (10^4-point outline, obstacle, outline + 10^4 boxes) —
+and times ``stealth validate`` (and, with ``--levels``,
 ``stealth levels``) on each in a subprocess with a timeout. Acceptance: validate on the
 pillars within 20 s, the others within 30 s or one error line.
 
@@ -38,12 +40,21 @@ def levels(folder: Path) -> dict[str, Path]:
             for i in range(n)]
     boxes = [[[x, y], [x + 2, y], [x + 2, y + 2], [x, y + 2]]
              for x in range(200, 800, 6) for y in range(200, 800, 6)][:10_000]
+    m = 10_000  # MAX_POLYGON_VERTICES: the largest polygons a level may have
+    ring4 = [[r + r * math.cos(2 * math.pi * i / m), r + r * math.sin(2 * math.pi * i / m)] for i in range(m)]
+    hole4 = [[500 + 200 * math.cos(2 * math.pi * i / m), 500 + 200 * math.sin(2 * math.pi * i / m)]
+             for i in range(m)]
     docs = {
         "pillars1000": {"grid": grid, "guards": [[0.5, 0.5]]},
         "outline1e5": {"cell_size": 10.0, "outline": ring, "guards": [[500, 500]]},
         "obstacle1e5": {"cell_size": 10.0, "outline": [[0, 0], [1000, 0], [1000, 1000], [0, 1000]],
                         "obstacles": [hole], "guards": [[50, 50]]},
         "outline1e5_obstacles1e4": {"cell_size": 2.0, "outline": ring, "obstacles": boxes,
+                                    "guards": [[500, 150]]},
+        "outline1e4": {"cell_size": 10.0, "outline": ring4, "guards": [[500, 500]]},
+        "obstacle1e4": {"cell_size": 10.0, "outline": [[0, 0], [1000, 0], [1000, 1000], [0, 1000]],
+                        "obstacles": [hole4], "guards": [[50, 50]]},
+        "outline1e4_obstacles1e4": {"cell_size": 2.0, "outline": ring4, "obstacles": boxes,
                                     "guards": [[500, 150]]},
     }
     paths = {}

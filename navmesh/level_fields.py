@@ -17,7 +17,7 @@ from shapely.geometry.polygon import orient
 
 from navmesh.errors import LevelError
 
-__all__ = ["MAX_CELLS", "MAX_SPOTS", "ZONE_KINDS", "register_zone_kind", "zone_kinds"]
+__all__ = ["MAX_CELLS", "MAX_LEVEL_VERTICES", "MAX_POLYGON_VERTICES", "MAX_SPOTS", "ZONE_KINDS", "register_zone_kind", "zone_kinds"]
 
 MAX_FILE_BYTES = 64 * 2**20
 """Largest level file read (64 MiB; the bundled levels are a few kB)."""
@@ -34,6 +34,16 @@ MAX_CELLS = 1_000_000
 
 MAX_SPOTS = 1000
 """Most guard, decoy or collectible points a level may list (each is a body in the world)."""
+
+MAX_POLYGON_VERTICES = 10_000
+"""Most points of one polygon (the outline, an obstacle, a zone).  Beyond, the navmesh's
+build (GEOS's constrained Delaunay of a 10^5-point hole: minutes; the refinement of a
+many-cornered round room) outgrows the 30 s a level may take: ``stealth levels`` on a
+regular polygon of 10^4 points takes 7 s, of 2 × 10^4 points 15-20 s (docs/hostile-inputs.md)."""
+
+MAX_LEVEL_VERTICES = 200_000
+"""Most points of the outline and the obstacles together (a 1000×1000-cell building of
+rooms has 86,000)."""
 
 ZONE_KINDS = ("dark", "concealment")
 """The built-in zone kinds; a stimulus may declare more with :func:`register_zone_kind`."""
@@ -149,10 +159,14 @@ def _parse_polygon(value: Any, src: str, field: str) -> Polygon:
     """A simple polygon from a list of points (closing point optional)."""
     if not isinstance(value, _ARRAY_TYPES):
         _fail(src, field, f"expected a polygon (an array of [x, y] points), got {_describe(value)}")
+    if len(value) > MAX_POLYGON_VERTICES + 1:  # before reading a point (+1: a closing point)
+        _fail(src, field, f"polygon of {len(value)} points, more than the limit of {MAX_POLYGON_VERTICES}")
     points = [_point(p, src, f"{field}[{i}]") for i, p in enumerate(value)]
     ring = [p for i, p in enumerate(points) if i == 0 or p != points[i - 1]]
     if len(ring) > 1 and ring[0] == ring[-1]:
         ring.pop()
+    if len(ring) > MAX_POLYGON_VERTICES:
+        _fail(src, field, f"polygon of {len(ring)} points, more than the limit of {MAX_POLYGON_VERTICES}")
     distinct = len(set(ring))
     if distinct < 3:
         _fail(src, field, f"polygon needs at least 3 distinct points, got {distinct}")
@@ -232,6 +246,10 @@ def _polygon_geometry(
 
     if not isinstance(obstacles_value, _ARRAY_TYPES):
         _fail(src, "obstacles", f"expected an array of polygons, got {_describe(obstacles_value)}")
+    corners = len(outline.exterior.coords) - 1 + sum(len(o) for o in obstacles_value if isinstance(o, _ARRAY_TYPES))
+    if corners > MAX_LEVEL_VERTICES:
+        _fail(src, "obstacles", f"outline and obstacles have {corners} points in all, more than the limit "
+                                f"of {MAX_LEVEL_VERTICES}")
     obstacles = _polygons_overlapping(
         obstacles_value, outline, src, "obstacles", "obstacle lies entirely outside the outline"
     )

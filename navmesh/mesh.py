@@ -50,12 +50,19 @@ from navmesh.triangulate import (
     wall_edges,
 )
 
-__all__ = ["DEFAULT_MIN_ANGLE", "MAX_CORNERS", "METHODS", "NavMesh", "NavPath", "OutsideError"]
+__all__ = ["DEFAULT_MIN_ANGLE", "MAX_CORNERS", "MAX_REFINE_WORK", "MAX_STEINER", "METHODS", "NavMesh", "NavPath", "OutsideError"]
 
 #: Triangulation methods accepted by :meth:`NavMesh.build`.
 METHODS = ("refined", "cdt", "earcut")
 #: Minimum angle (degrees) the default ``"refined"`` method asks for.
 DEFAULT_MIN_ANGLE = 20.0
+#: The refinement's budgets (``docs/navmesh.md``): at most this many Steiner points and
+#: :attr:`~navmesh.refine.Refiner.work` steps (walk steps, cavity triangles, flip tests),
+#: about 10 s.  A 1000×1000-cell building needs 9 × 10^4 points and 7 × 10^5 steps; a
+#: regular polygon of 10^5 corners (all its slivers' circumcentres at its centre) would
+#: need millions of points, each insertion visiting thousands of triangles.
+MAX_STEINER = 100_000
+MAX_REFINE_WORK = 1_500_000
 _MAX_MIN_ANGLE = 34.0  # Ruppert's refinement is only guaranteed to stop below ~33.8 degrees
 
 
@@ -110,6 +117,9 @@ class NavMesh:
         bv[t[wt, (wk + 1) % 3]] = True
         bv[t[wt, (wk + 2) % 3]] = True
         self.boundary_vertex = bv
+        #: True when the refinement's budget (:data:`MAX_STEINER`) stopped it with triangles
+        #: below ``min_angle`` (or above ``max_area``) left: a conforming mesh all the same
+        self.refinement_stopped = False
         self._build_locator(lo, hi)
 
     # ---------------------------------------------------------------- building
@@ -165,8 +175,11 @@ class NavMesh:
             budget = 20 * len(verts) + 2000
             if max_area:
                 budget += int(4 * polygon.area / max_area)
-            ref.refine(min_angle, max_area, budget)
+            finished = ref.refine(min_angle, max_area, min(budget, MAX_STEINER), MAX_REFINE_WORK)
             verts, tris = ref.arrays()
+            mesh = cls(verts, tris)
+            mesh.refinement_stopped = not finished
+            return mesh
         return cls(verts, tris)
 
     def _build_locator(self, lo: np.ndarray, hi: np.ndarray) -> None:

@@ -14,7 +14,11 @@ import math
 
 import numpy as np
 
+from navmesh.plane import angle_at as _angle
+from navmesh.plane import circumcentre as _circumcentre
+from navmesh.plane import orient2 as _orient2
 from navmesh.predicates import flip_candidates, quality_candidates, small_angle_candidates
+from navmesh.refine_locate import Locating
 from navmesh.rings import ring_neighbours
 from navmesh.triangulate import edge_neighbors, vertex_ids
 
@@ -24,11 +28,7 @@ __all__ = ["Refiner"]
 _NEXT, _PREV = (1, 2, 0), (2, 0, 1)  # (k + 1) % 3 and (k + 2) % 3
 
 
-def _orient2(ax: float, ay: float, bx: float, by: float, cx: float, cy: float) -> float:
-    return (bx - ax) * (cy - ay) - (by - ay) * (cx - ax)
-
-
-class Refiner:
+class Refiner(Locating):
     """Mutable constrained triangulation: Lawson flips and Ruppert-style Steiner refinement.
 
     Boundary edges (no neighbour) are the constraints and are never flipped.  Every
@@ -45,6 +45,7 @@ class Refiner:
         self.tol = tol
         self.dirty: list[int] = []
         self.n_input = len(verts)
+        self.work = 0
         # input segments and the input angle at every input vertex (for the small-angle rule);
         # numpy picks the vertices that may be below 60 degrees, the scalar test decides
         self.small: set[int] = set()
@@ -172,6 +173,7 @@ class Refiner:
     def _legalize_around(self, p: int, tris: list[int]) -> None:
         stack = list(tris)
         while stack:
+            self.work += 1
             t = stack.pop()
             k = self.tri[t].index(p)
             if self._should_flip(t, k):
@@ -318,63 +320,15 @@ class Refiner:
             return all(o < self.n_input or v in self.on_seg.get(o, ()) for o in others)
         return False
 
-    def _walk(self, t: int, px: float, py: float) -> tuple[int, int]:
-        """Walk from t towards p: (triangle, -1) containing p, or (triangle, k) blocked by boundary edge k."""
-        x, y = self.x, self.y
-        a, b, c = self.tri[t]
-        ox, oy = (x[a] + x[b] + x[c]) / 3.0, (y[a] + y[b] + y[c]) / 3.0
-        eps = self.tol * self.tol
-        for _ in range(4 * len(self.tri) + 10):
-            tri = self.tri[t]
-            exit_k = -1
-            for k in range(3):
-                v1, v2 = tri[(k + 1) % 3], tri[(k + 2) % 3]
-                if _orient2(x[v1], y[v1], x[v2], y[v2], px, py) < -eps:
-                    o1 = _orient2(ox, oy, px, py, x[v1], y[v1])
-                    o2 = _orient2(ox, oy, px, py, x[v2], y[v2])
-                    if o1 * o2 <= 0.0:
-                        exit_k = k
-                        break
-                    if exit_k < 0:
-                        exit_k = k + 3  # fallback when the walk line grazes a vertex
-            if exit_k < 0:
-                return t, -1
-            exit_k %= 3
-            u = self.nbr[t][exit_k]
-            if u < 0:
-                return t, exit_k
-            t = u
-        return t, -2
+    def refine(self, min_angle: float | None, max_area: float | None, max_steiner: int,
+               max_work: int | None = None) -> bool:
+        """Ruppert's algorithm: split encroached segments, insert circumcentres of bad triangles.
 
-    def _cavity_segments(self, t: int, px: float, py: float) -> list[tuple[int, int]]:
-        """Boundary edges of the triangles whose circumcircle holds p (those p may encroach)."""
-        x, y = self.x, self.y
-        seen, stack, segs = {t}, [t], []
-        q = self._new_vertex(px, py)
-        try:
-            while stack:
-                s = stack.pop()
-                tri, nb = self.tri[s], self.nbr[s]
-                for k in range(3):
-                    u = nb[k]
-                    if u < 0:
-                        segs.append((tri[(k + 1) % 3], tri[(k + 2) % 3]))
-                    elif u not in seen:
-                        ua, ub, uc = self.tri[u]
-                        if self._incircle(ua, ub, uc, q) > 1e-12:
-                            seen.add(u)
-                            stack.append(u)
-        finally:
-            self.x.pop()
-            self.y.pop()
-        out = []
-        for b, c in segs:
-            if (x[b] - px) * (x[c] - px) + (y[b] - py) * (y[c] - py) < 0.0:
-                out.append((b, c))
-        return out
-
-    def refine(self, min_angle: float | None, max_area: float | None, max_steiner: int) -> None:
-        """Ruppert's algorithm: split encroached segments, insert circumcentres of bad triangles."""
+        At most ``max_steiner`` Steiner points and about ``max_work`` steps (walk steps,
+        cavity triangles, flip tests: :attr:`work`; an insertion can cost as many as the
+        mesh has triangles).  True when nothing is left to do; False when a budget stopped
+        it with bad triangles left (the mesh is conforming all the same).
+        """
         sin_min = math.sin(math.radians(min_angle)) if min_angle else 0.0
         area_cap = max_area if max_area else 0.0
         self.legalize_all()
@@ -397,7 +351,8 @@ class Refiner:
         budget = max_steiner
         retries: dict[tuple[int, ...], int] = {}
         steps = 0
-        while budget > 0 and (segq or badq) and steps < 50 * max_steiner:
+        work_cap = max_work if max_work is not None else math.inf
+        while budget > 0 and (segq or badq) and steps < 50 * max_steiner and self.work < work_cap:
             steps += 1
             if segq:
                 b, c = segq.pop()
@@ -422,7 +377,15 @@ class Refiner:
                 tri = self.tri[s]
                 enc = [(tri[(k + 1) % 3], tri[(k + 2) % 3])]
             else:
-                enc = self._cavity_segments(s, cx, cy)
+                # no point nearer a vertex than the shortest segment split (1000 tolerances):
+                # the circumcentres of a regular polygon's slivers all meet at its centre, up
+                # to rounding, and triangles that small defeat the tolerance tests.  The
+                # triangle's own corners first (cheap), then the cavity's (p's nearest vertex)
+                if self._near_vertex(s, cx, cy, 1e3 * self.tol):
+                    continue
+                enc, gap = self._cavity(s, cx, cy)
+                if gap < 1e3 * self.tol:
+                    continue
             if enc:
                 # split the encroached walls instead, then try this triangle again (a few
                 # times only: a wall too short to split would otherwise loop for ever)
@@ -431,10 +394,12 @@ class Refiner:
                 if retries[key] <= 3:
                     heapq.heappush(badq, (q, t, key))
                 continue
-            self._insert_point(s, cx, cy)
+            if not self._insert_point(s, cx, cy):
+                continue
             budget -= 1
             ts, self.dirty = self.dirty, []
             scan(ts)
+        return not segq and not any(tuple(self.tri[t]) == key for _, t, key in badq)
 
     def _scan_all(self, segq: list[tuple[int, int]], badq: list[tuple[float, int, tuple[int, ...]]],
                   sin_min: float, area_cap: float) -> None:
@@ -459,31 +424,32 @@ class Refiner:
             if q < 1.0:
                 heapq.heappush(badq, (q, t, tuple(self.tri[t])))
 
-    def _insert_point(self, t: int, px: float, py: float) -> None:
+    def _insert_point(self, t: int, px: float, py: float) -> bool:
+        """Insert p into t (or onto the edge of t it lies on); False, inserting nothing,
+        when a triangle it would make is not counter-clockwise by :func:`_orient2` (p
+        beyond an edge by the rounding of a sliver: the flips' tests would stop agreeing
+        and the mesh could stop being a manifold)."""
         tri = self.tri[t]
         x, y = self.x, self.y
         for k in range(3):
-            v1, v2 = tri[(k + 1) % 3], tri[(k + 2) % 3]
+            a, v1, v2 = tri[k], tri[(k + 1) % 3], tri[(k + 2) % 3]
             el = math.hypot(x[v2] - x[v1], y[v2] - y[v1])
             if abs(_orient2(x[v1], y[v1], x[v2], y[v2], px, py)) <= self.tol * el:
+                u = self.nbr[t][k]
+                sides = [(a, v1), (v2, a)]
+                if u >= 0:
+                    d = self.tri[u][self.nbr[u].index(t)]
+                    sides += [(d, v2), (v1, d)]
+                if not all(_orient2(x[i], y[i], x[j], y[j], px, py) > 0.0 for i, j in sides):
+                    return False
                 self.insert_on_edge(t, k, px, py)
-                return
+                return True
+        a, b, c = tri
+        if not all(_orient2(x[i], y[i], x[j], y[j], px, py) > 0.0 for i, j in ((a, b), (b, c), (c, a))):
+            return False
         self.insert_in_triangle(t, px, py)
+        return True
 
     def arrays(self) -> tuple[np.ndarray, np.ndarray]:
         return np.column_stack([self.x, self.y]), np.asarray(self.tri, dtype=np.int64)
 
-
-def _angle(ax: float, ay: float, bx: float, by: float, cx: float, cy: float) -> float:
-    """Angle at a between rays a→b and a→c, in [0, π]."""
-    ux, uy, vx, vy = bx - ax, by - ay, cx - ax, cy - ay
-    return abs(math.atan2(ux * vy - uy * vx, ux * vx + uy * vy))
-
-
-def _circumcentre(ax: float, ay: float, bx: float, by: float, cx: float, cy: float) -> tuple[float, float]:
-    bx, by, cx, cy = bx - ax, by - ay, cx - ax, cy - ay
-    d = 2.0 * (bx * cy - by * cx)
-    if d == 0.0:
-        return math.nan, math.nan
-    b2, c2 = bx * bx + by * by, cx * cx + cy * cy
-    return ax + (cy * b2 - by * c2) / d, ay + (bx * c2 - cx * b2) / d
