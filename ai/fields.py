@@ -30,6 +30,7 @@ frame's spare time is :mod:`ai.prefetch`. The names of those modules are re-expo
 
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
 from typing import NamedTuple
 
@@ -368,13 +369,17 @@ class CompositeField:
                 total = row[0]
                 for value in row[1:]:
                     total += value
-                scores[j] = scores[j] + scale * total
-        revisit = self.revisit_term(candidates, recent)
-        if revisit is not None:
-            scores = [a + b for a, b in zip(scores, revisit.tolist(), strict=True)]
+                scores[j] += scale * total
+        revisit = self.w_C * p.revisit_penalty * p.C0  # revisit_term, inline
+        if len(recent) and revisit:
+            found = set(np.asarray(recent).tolist()) if isinstance(recent, np.ndarray) else set(recent)
+            hit, miss = revisit * 1.0, revisit * 0.0
+            for j, c in enumerate(cands):
+                scores[j] += hit if c in found else miss
         if personal is not None:
-            scores = [a + b for a, b in zip(scores, personal[candidates].tolist(), strict=True)]
-        if any(x != x for x in scores):
+            for j, value in enumerate(personal[candidates].tolist()):
+                scores[j] += value
+        if any(map(math.isnan, scores)):
             return None
         low, eps = min(scores), p.tie_eps
         tied = [c for c, x in zip(cands, scores, strict=True) if x - low < eps]
