@@ -364,7 +364,9 @@ class CompositeField:
         scale = self.w_C * p.teammate_presence * p.C0
         if len(teammates) and scale:
             tm = np.asarray(teammates, dtype=np.intp)
-            picked = self.matrices.presence_table[candidates[:, None], tm].tolist()
+            table = self.matrices.presence_table
+            assert table is not None  # spreads.tables: the dense table exists
+            picked = table[candidates[:, None], tm].tolist()
             for j, row in enumerate(picked):
                 total = row[0]
                 for value in row[1:]:
