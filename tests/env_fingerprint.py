@@ -57,7 +57,7 @@ def play(kind: str, level: str, abstraction: str, steps: int) -> list[str]:
         env = StealthEnv(level, abstraction=abstraction, rewards=RECORDED_REWARDS)
         obs, info = env.reset(seed=7)
         out.append(_digest(obs, info))
-        n = int(env.action_space.n)
+        n = int(env.action_space.n)  # type: ignore[attr-defined]
         for _ in range(steps):
             obs, reward, terminated, truncated, info = env.step(int(rng.integers(n)))
             out.append(_digest(obs, float(reward), terminated, truncated, info))
@@ -66,16 +66,16 @@ def play(kind: str, level: str, abstraction: str, steps: int) -> list[str]:
                 out.append(_digest(obs, info))
         return out
     penv = parallel_env(level, abstraction, rewards=RECORDED_REWARDS)
-    obs, infos = penv.reset(seed=7)
-    out.append(_digest(obs, infos))
-    n = int(penv.action_space("player").n)
+    pobs, infos = penv.reset(seed=7)
+    out.append(_digest(pobs, infos))
+    m = int(penv.action_space("player").n)
     for _ in range(steps):
-        actions = {a: int(rng.integers(n)) for a in penv.agents}
-        obs, rewards, terms, truncs, infos = penv.step(actions)
-        out.append(_digest(obs, {a: float(r) for a, r in rewards.items()}, terms, truncs, infos))
+        actions = {a: int(rng.integers(m)) for a in penv.agents}
+        pobs, rewards, terms, truncs, infos = penv.step(actions)
+        out.append(_digest(pobs, {a: float(r) for a, r in rewards.items()}, terms, truncs, infos))
         if not penv.agents:
-            obs, infos = penv.reset()
-            out.append(_digest(obs, infos))
+            pobs, infos = penv.reset()
+            out.append(_digest(pobs, infos))
     return out
 
 
