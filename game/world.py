@@ -224,8 +224,7 @@ class World(PlayerActions):
         else:
             walk.drive(self.player, player_speed)
 
-        agents = [*self.guards, self.player]
-        before = [a.pos for a in agents]
+        before = [a.pos for a in (agents := [*self.guards, self.player])]
         sprint = self.sprinting
         self.space.step(self.dt)
         self.step_index += 1
@@ -238,14 +237,12 @@ class World(PlayerActions):
                 if not self.done:  # respawned: a teleport, not a walk (no footsteps, no stall)
                     before[-1] = self.player.pos
 
-        settle, node_near, stuck = walk.settle, self.graph.node_near, self.stuck_timeout
-        last = len(agents) - 1  # the player, after the guards
+        settle, node_near, last = walk.settle, self.graph.node_near, len(agents) - 1  # player last
         for i, agent in enumerate(agents):
-            if settle(agent, before[i], agent.speed if i < last else player_speed, stuck) \
-                    and i < last:
+            speed = agent.speed if i < last else player_speed
+            if settle(agent, before[i], speed, self.stuck_timeout) and i < last:
                 self.m.count_arrival(agent.history, agent.target)  # the player is not scored
-            x, y = agent.pos
-            node = node_near(x, y, agent.node)
+            node = node_near(agent.pos[0], agent.pos[1], agent.node)
             if node != agent.node:
                 self._enter_node(agent, node, i)
         self.player_moved = self.player.pos != before[-1]
@@ -274,18 +271,8 @@ class World(PlayerActions):
         """Vision, attack damage, distance and detection metrics for the current positions."""
         ppos = self.player.pos
         reach = self.view_reach()  # once per step, not once per guard
-        perceives, attack_range, attack_los = self.senses.perceives, self.attack_range, self.attack_los
-        # one pass over the active guards: the tests of self.sees and of attack range
-        seeing, attackers, nodes, positions = [], 0, [], []
-        for i, g in enumerate(self.guards):
-            if not g.active:
-                continue
-            if perceives(g.pos, g.heading, ppos, reach):
-                seeing.append(i)
-            if perceives(g.pos, None, ppos, attack_range, line_of_sight=attack_los):
-                attackers += 1
-            nodes.append(g.node)
-            positions.append(g.pos)
+        seeing, attackers, nodes, positions = _guard_senses(
+            self.guards, self.senses, ppos, reach, self.attack_range, self.attack_los)
         self.seen_by = self.team.detect(self, tuple(seeing))
         if self.seen_by:
             self.sighting = self.player.node
@@ -350,6 +337,25 @@ class World(PlayerActions):
     def trace_record(self) -> dict[str, Any]:
         """One trace line (:func:`game.trace.trace_record`)."""
         return trace.trace_record(self)
+
+
+def _guard_senses(guards: list[Agent], senses: Senses, ppos: tuple[float, float], reach: float,
+                  attack_range: float, attack_los: bool
+                  ) -> tuple[list[int], int, list[int], list[tuple[float, float]]]:
+    """One pass over the active guards: which see the player (:meth:`World.sees`), how many
+    are in attack range, and their nodes and positions (the distance metrics' samples)."""
+    perceives = senses.perceives
+    seeing, attackers, nodes, positions = [], 0, [], []
+    for i, g in enumerate(guards):
+        if not g.active:
+            continue
+        if perceives(g.pos, g.heading, ppos, reach):
+            seeing.append(i)
+        if perceives(g.pos, None, ppos, attack_range, line_of_sight=attack_los):
+            attackers += 1
+        nodes.append(g.node)
+        positions.append(g.pos)
+    return seeing, attackers, nodes, positions
 
 
 def decision_interval(world: Mapping[str, Any], *, grid: bool) -> float:
