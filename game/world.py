@@ -224,7 +224,8 @@ class World(PlayerActions):
         else:
             walk.drive(self.player, player_speed)
 
-        before = [a.pos for a in (agents := [*self.guards, self.player])]
+        agents = [*self.guards, self.player]
+        before = [a.pos for a in agents]
         sprint = self.sprinting
         self.space.step(self.dt)
         self.step_index += 1
@@ -238,8 +239,7 @@ class World(PlayerActions):
                     before[-1] = self.player.pos
 
         settle, node_near, last = walk.settle, self.graph.node_near, len(agents) - 1  # player last
-        for i, agent in enumerate(agents):
-            speed = agent.speed if i < last else player_speed
+        for i, (agent, speed) in enumerate(zip(agents, [g.speed for g in self.guards] + [player_speed])):
             if settle(agent, before[i], speed, self.stuck_timeout) and i < last:
                 self.m.count_arrival(agent.history, agent.target)  # the player is not scored
             node = node_near(agent.pos[0], agent.pos[1], agent.node)
