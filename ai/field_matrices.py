@@ -98,8 +98,10 @@ class FieldMatrices:
         """
         table = self.presence_table
         if table is not None:
-            picked = table[np.ix_(self.candidates[node], np.asarray(teammates, dtype=np.intp))]
-            return np.ascontiguousarray(picked.T).sum(axis=0)
+            # (t, c) = table[c, t] transposed, gathered directly (C-contiguous, as the copy
+            # of np.ix_'s (c, t) transpose was): the same rows summed in the same order
+            tm = np.asarray(teammates, dtype=np.intp)
+            return table[self.candidates[node][None, :], tm[:, None]].sum(axis=0)
         cols, weights = self.kernel_rows(node)
         smoothed = np.empty((len(teammates), len(cols)))  # (t, c): one row per teammate
         for k, t in enumerate(teammates):

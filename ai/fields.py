@@ -30,6 +30,7 @@ frame's spare time is :mod:`ai.prefetch`. The names of those modules are re-expo
 
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
 from typing import NamedTuple
 
@@ -314,6 +315,22 @@ class CompositeField:
         if len(candidates) == 0:
             empty = np.zeros(0, dtype=np.intp)
             return Choice(int(node), empty, np.zeros(0), empty)
+        if self.matrices.spreads.tables:  # a dense graph: a handful of floats, no arrays
+            choice = self._select_dense(candidates, rng, teammates, recent, personal)
+            if choice is not None:
+                return choice
+        return self._select_arrays(node, candidates, rng, teammates, recent, personal)
+
+    def _select_arrays(
+        self,
+        node: int,
+        candidates: np.ndarray,
+        rng: np.random.Generator,
+        teammates: Sequence[int] | np.ndarray,
+        recent: Sequence[int] | np.ndarray,
+        personal: np.ndarray | None,
+    ) -> Choice:
+        """:meth:`select` on arrays (any graph; large ones read K at the candidates alone)."""
         scores = self.kernel_at(node)
         scale = self.w_C * self.params.teammate_presence * self.params.C0
         if len(teammates) and scale:
@@ -323,9 +340,54 @@ class CompositeField:
             scores = scores + revisit
         if personal is not None:
             scores = scores + personal[candidates]
-        tied = candidates[scores - scores.min() < self.params.tie_eps]
+        # np.minimum.reduce is what ndarray.min calls, without its Python wrapper (~1 us)
+        tied = candidates[scores - np.minimum.reduce(scores) < self.params.tie_eps]
         winner = tied[0] if len(tied) == 1 else tied[rng.integers(len(tied))]
         return Choice(int(winner), candidates, scores, tied)
+
+    def _select_dense(
+        self,
+        candidates: np.ndarray,
+        rng: np.random.Generator,
+        teammates: Sequence[int] | np.ndarray,
+        recent: Sequence[int] | np.ndarray,
+        personal: np.ndarray | None,
+    ) -> Choice | None:
+        """:meth:`select` on Python floats, for a graph with dense tables: each score is
+        the same IEEE operations in the same order as the array path (K, plus scale ×
+        the teammates' presence summed left to right, plus the revisit term, plus the
+        personal term), so the same bits and the same draw; None (use the array path)
+        when a score is NaN, where Python's ``min`` and numpy's disagree."""
+        cands = candidates.tolist()
+        scores = self.kernel()[candidates].tolist()
+        p = self.params
+        scale = self.w_C * p.teammate_presence * p.C0
+        if len(teammates) and scale:
+            tm = np.asarray(teammates, dtype=np.intp)
+            table = self.matrices.presence_table
+            assert table is not None  # spreads.tables: the dense table exists
+            picked = table[candidates[:, None], tm].tolist()
+            for j, row in enumerate(picked):
+                total = row[0]
+                for value in row[1:]:
+                    total += value
+                scores[j] += scale * total
+        revisit = self.w_C * p.revisit_penalty * p.C0  # revisit_term, inline
+        if len(recent) and revisit:
+            found = set(np.asarray(recent).tolist()) if isinstance(recent, np.ndarray) else set(recent)
+            hit, miss = revisit * 1.0, revisit * 0.0
+            for j, c in enumerate(cands):
+                scores[j] += hit if c in found else miss
+        if personal is not None:
+            for j, value in enumerate(personal[candidates].tolist()):
+                scores[j] += value
+        if any(map(math.isnan, scores)):
+            return None
+        low, eps = min(scores), p.tie_eps
+        tied = [c for c, x in zip(cands, scores, strict=True) if x - low < eps]
+        winner = tied[0] if len(tied) == 1 else tied[rng.integers(len(tied))]
+        return Choice(int(winner), candidates, np.array(scores, dtype=np.float64),
+                      np.array(tied, dtype=candidates.dtype))
 
     def choose(
         self,
@@ -344,9 +406,13 @@ class CompositeField:
         scale = self.w_C * self.params.revisit_penalty * self.params.C0
         if not len(recent) or not scale:
             return None
-        # a broadcast compare: np.isin costs ~25 us on these 4-10 element arrays
-        recent_nodes = np.fromiter(recent, dtype=np.intp, count=len(recent))
-        return scale * (candidates[:, None] == recent_nodes).any(axis=1)
+        # per candidate scale × (in recent): the same products as numpy's scale × a bool
+        # array (× 1.0 or × 0.0, so a negative scale still gives -0.0), from a set on
+        # Python ints: np.isin costs ~25 us on these 4-10 element arrays, a broadcast ~4 us
+        found = set(np.asarray(recent).tolist()) if isinstance(recent, np.ndarray) else set(recent)
+        hit, miss = scale * 1.0, scale * 0.0
+        return np.array([hit if c in found else miss for c in candidates.tolist()],
+                        dtype=np.float64)
 
     def teammate_confidence(self, teammates: Sequence[int] | np.ndarray) -> np.ndarray:
         """C_live (n,): teammates' deposit at their current nodes × teammate_presence."""

@@ -249,11 +249,10 @@ class PotentialFieldGuards(GuardAI):
 
 def _teammate_nodes(view: WorldView, i: int) -> np.ndarray:
     """Current nodes of the active guards other than ``i``."""
-    others = np.ones(len(view.guard_nodes), dtype=bool)
-    others[i] = False
-    if view.guard_active is not None:
-        others &= np.asarray(view.guard_active, dtype=bool)
-    return np.asarray(view.guard_nodes, dtype=np.intp)[others]
+    active = view.guard_active
+    others = [k for k in range(len(view.guard_nodes))
+              if k != i and (active is None or active[k])]
+    return np.asarray(view.guard_nodes, dtype=np.intp)[np.array(others, dtype=np.intp)]
 
 
 __all__ = ["PotentialFieldGuards"]

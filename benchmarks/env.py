@@ -22,12 +22,15 @@ from game.env import StealthEnv
 from game.trial import TrialSpec, make_world
 
 
-def env_rate(level: str, abstraction: str, seconds: float) -> tuple[float, float]:
-    """(env steps/s, physics steps per env step) of random actions for ``seconds``."""
+def env_rate(level: str, abstraction: str, seconds: float) -> tuple[float, float, float]:
+    """(env steps/s, physics steps per env step, env steps per CPU second) of random
+    actions for ``seconds``; the CPU rate counts this process's time alone, so it says
+    less about what else runs on the machine."""
     env = StealthEnv(level, abstraction=abstraction)
     env.action_space.seed(0)
     env.reset(seed=0)
     steps = physics = 0
+    cpu = time.process_time()
     start = time.perf_counter()
     while time.perf_counter() - start < seconds:
         before = env.match.world.step_index
@@ -36,7 +39,8 @@ def env_rate(level: str, abstraction: str, seconds: float) -> tuple[float, float
         steps += 1
         if terminated or truncated:
             env.reset()
-    return steps / (time.perf_counter() - start), physics / max(1, steps)
+    wall = time.perf_counter() - start
+    return steps / wall, physics / max(1, steps), steps / max(1e-9, time.process_time() - cpu)
 
 
 def world_rate(level: str, abstraction: str, seconds: float) -> float:
@@ -63,13 +67,13 @@ def main() -> None:
     if args.profile:
         profiler = cProfile.Profile()
         profiler.enable()
-    rate, per_step = env_rate(args.level, args.abstraction, args.seconds)
+    rate, per_step, cpu_rate = env_rate(args.level, args.abstraction, args.seconds)
     if args.profile:
         profiler.disable()
         pstats.Stats(profiler).sort_stats("cumulative").print_stats(25)
     reference = world_rate(args.level, args.abstraction, args.seconds)
     print(f"{args.level} {args.abstraction}: env {rate:,.0f} steps/s "
-          f"({per_step:.1f} physics steps each)")
+          f"({per_step:.1f} physics steps each; {cpu_rate:,.0f} per CPU second)")
     print(f"reference: headless world {reference:,.0f} physics steps/s "
           f"= {reference / per_step:,.0f} moves/s; env / reference {rate * per_step / reference:.2f}")
 

@@ -28,6 +28,7 @@ AGENT_CATEGORY = 0b10
 #: deadlock, and the paper's agents pass through each other too.
 AGENT_FILTER = pymunk.ShapeFilter(categories=AGENT_CATEGORY, mask=WALL_CATEGORY)
 WALL_QUERY = pymunk.ShapeFilter(mask=WALL_CATEGORY)
+WALL_SHAPES = pymunk.ShapeFilter(categories=WALL_CATEGORY)
 ARRIVE_EPS = 1e-3
 
 
@@ -79,15 +80,20 @@ class Agent:
 
 
 def build_space(level: Level) -> pymunk.Space:
-    """A gravity-free pymunk space with the level's walls as frictionless static segments."""
+    """A gravity-free pymunk space with the level's walls as frictionless static segments.
+
+    A shape's friction and elasticity start at 0 (chipmunk's cpShapeInit), so they are not
+    set again, and the walls are added in one call in the same order: pymunk's attribute
+    writes cost ~5 µs each, and an env builds a space every episode.
+    """
     space = pymunk.Space()
     space.gravity = (0.0, 0.0)
+    walls = []
     for (ax, ay), (bx, by) in level.walls:
         wall = pymunk.Segment(space.static_body, (ax, ay), (bx, by), 0.0)
-        wall.filter = pymunk.ShapeFilter(categories=WALL_CATEGORY)
-        wall.friction = 0.0
-        wall.elasticity = 0.0
-        space.add(wall)
+        wall.filter = WALL_SHAPES
+        walls.append(wall)
+    space.add(*walls)
     return space
 
 

@@ -20,6 +20,11 @@ The line of sight is where the two differ, each as its reader needs it:
   plainly (no end of either segment within rounding of the other) is blocked without a
   ray; every other line is the pymunk query the player's sight uses
   (:meth:`game.senses.Senses.clear_line`), so the metric is that rule exactly.
+
+  Its work is deferred: an AI tick only notes the active guards' positions and headings,
+  worked through in tick order when :attr:`ViewCover.seen` is read (the trial's metrics) or
+  when :data:`PENDING_TICKS` of them wait. The walls never move, so the answer is the same
+  bits as working each tick at once; an env episode nobody scores by coverage never pays.
 """
 
 from __future__ import annotations
@@ -37,7 +42,10 @@ from navmesh.graph import NodeGraph
 from .agents import WALL_QUERY, Agent
 from .senses import RANGE_EPS, Senses
 
-__all__ = ["GuardSight", "ViewCover", "nodes_within"]
+__all__ = ["PENDING_TICKS", "GuardSight", "ViewCover", "nodes_within"]
+
+#: AI ticks noted before the cover is brought up to date (bounds the notes' memory)
+PENDING_TICKS = 256
 
 #: a side test within this share of |ray|·|wall| of zero is left to pymunk (rounding)
 _TOLERANCE = 1e-9
@@ -172,35 +180,59 @@ class ViewCover(_NodeView):
     def __init__(self, graph: NodeGraph, senses: Senses, reach: np.ndarray) -> None:
         super().__init__(graph, senses, reach)
         self.bound = float(self.reach.max()) if len(self.reach) else 0.0
-        self.seen = np.zeros(graph.n, dtype=bool)
-        #: per node: the wall (index into ``_walls``) that blocked its last ray, or -1
-        self.blocker = np.full(graph.n, -1, dtype=np.int32)
+        self._seen = np.zeros(graph.n, dtype=bool)
+        self._blocker = np.full(graph.n, -1, dtype=np.int32)
+        #: per noted AI tick: the active guards' (x, y, heading), not yet worked through
+        self._pending: list[list[tuple[float, float, float]]] = []
         walls = [shape for shape in senses.space.shapes if isinstance(shape, pymunk.Segment)]
         self._wall_index: dict[pymunk.Shape, int] = {shape: i for i, shape in enumerate(walls)}
         ends = [(*shape.a, *shape.b) for shape in walls]
         self._walls = np.array(ends, dtype=np.float64).reshape(-1, 4)
 
+    @property
+    def seen(self) -> np.ndarray:
+        """Per node: inside an active guard's view at some AI tick so far."""
+        self._catch_up()
+        return self._seen
+
+    @property
+    def blocker(self) -> np.ndarray:
+        """Per node: the wall (index into ``_walls``) that blocked its last ray, or -1."""
+        self._catch_up()
+        return self._blocker
+
     def observe(self, guards: Iterable[Agent]) -> None:
-        """Mark every node an active guard perceives now (one AI tick); the guards' nodes
-        in range are tested together, one array per test."""
-        active = [g for g in guards if g.active]
-        parts = [nodes_within(self.graph, g.pos[0], g.pos[1], self.bound) for g in active]
+        """Note what the active guards see now (one AI tick): their positions and headings,
+        worked through in order when :attr:`seen` is next read."""
+        self._pending.append([(g.pos[0], g.pos[1], g.heading) for g in guards if g.active])
+        if len(self._pending) >= PENDING_TICKS:
+            self._catch_up()
+
+    def _catch_up(self) -> None:
+        pending, self._pending = self._pending, []
+        for active in pending:
+            self._observe(active)
+
+    def _observe(self, active: list[tuple[float, float, float]]) -> None:
+        """Mark every node one tick's active guards (x, y, heading) perceive; the guards'
+        nodes in range are tested together, one array per test."""
+        parts = [nodes_within(self.graph, x, y, self.bound) for x, y, _ in active]
         if not parts:
             return
         near = np.concatenate(parts)
         owner = np.repeat(np.arange(len(active)), [len(p) for p in parts])
-        unseen = ~self.seen[near]
+        unseen = ~self._seen[near]
         near, owner = near[unseen], owner[unseen]
         if not len(near):
             return
-        pos = np.array([g.pos for g in active], dtype=np.float64)
+        pos = np.array([(x, y) for x, y, _ in active], dtype=np.float64)
         # math's cos and sin, as Senses.perceives takes them (numpy's may differ in a bit)
-        cos = np.array([math.cos(g.heading) for g in active])[owner]
-        sin = np.array([math.sin(g.heading) for g in active])[owner]
+        cos = np.array([math.cos(h) for _, _, h in active])[owner]
+        sin = np.array([math.sin(h) for _, _, h in active])[owner]
         gx, gy = pos[owner, 0], pos[owner, 1]
         keep, points, _, _ = self.in_view(near, gx, gy, cos, sin)
         keep[keep] = ~self._still_blocked(gx[keep], gy[keep], points[keep], near[keep])
-        query, seen, blocker = self.senses.space.segment_query_first, self.seen, self.blocker
+        query, seen, blocker = self.senses.space.segment_query_first, self._seen, self._blocker
         for k, (px, py), (x, y) in zip(near[keep].tolist(), points[keep].tolist(),
                                        pos[owner[keep]].tolist()):
             hit = query((x, y), (px, py), 0.0, WALL_QUERY)
@@ -214,7 +246,7 @@ class ViewCover(_NodeView):
         """Per line from (x, y) to a node's point: the wall that last blocked the node's ray
         plainly crosses it — both ends of each segment strictly on either side of the
         other, beyond rounding — so the ray would hit a wall too."""
-        wall = self.blocker[nodes]
+        wall = self._blocker[nodes]
         out = np.zeros(len(nodes), dtype=bool)
         known = np.flatnonzero(wall >= 0)
         if not len(known):
@@ -234,4 +266,5 @@ class ViewCover(_NodeView):
 
     def share(self) -> float:
         """The share of nodes seen so far (0 on an empty graph)."""
-        return float(self.seen.mean()) if len(self.seen) else 0.0
+        seen = self.seen
+        return float(seen.mean()) if len(seen) else 0.0

@@ -106,6 +106,14 @@ class Counters:
             self.dist_sum += self._dist_now
             self.dist_samples += 1
 
+    def cached_distance(self, player_node: int, guard_nodes: list[int]) -> float | None:
+        """The last sample's ``graph.nearest_dist_to(guard_nodes, player_node)`` when it was
+        taken for exactly these nodes (no worker), else None: a reader of the same distance
+        need not search again."""
+        if self.distance_worker is None and self._dist_key == (player_node, *guard_nodes):
+            return self._dist_now
+        return None
+
     def distances_ready(self) -> bool:
         """Whether :meth:`settle` would not wait: every search handed to the worker is done."""
         return self.distances_pending() == 0

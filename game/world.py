@@ -223,7 +223,8 @@ class World(PlayerActions):
         else:
             walk.drive(self.player, player_speed)
 
-        before = [a.pos for a in self.guards] + [self.player.pos]
+        agents = [*self.guards, self.player]
+        before = [a.pos for a in agents]
         sprint = self.sprinting
         self.space.step(self.dt)
         self.step_index += 1
@@ -236,11 +237,11 @@ class World(PlayerActions):
                 if not self.done:  # respawned: a teleport, not a walk (no footsteps, no stall)
                     before[-1] = self.player.pos
 
-        speeds = [g.speed for g in self.guards] + [player_speed]
-        for i, (agent, start, speed) in enumerate(zip(self.guards + [self.player], before, speeds)):
-            if walk.settle(agent, start, speed, self.stuck_timeout) and agent is not self.player:
+        settle, node_near, last = walk.settle, self.graph.node_near, len(agents) - 1  # player last
+        for i, (agent, speed) in enumerate(zip(agents, [g.speed for g in self.guards] + [player_speed])):
+            if settle(agent, before[i], speed, self.stuck_timeout) and i < last:
                 self.m.count_arrival(agent.history, agent.target)  # the player is not scored
-            node = self.graph.node_near(*agent.pos, agent.node)
+            node = node_near(agent.pos[0], agent.pos[1], agent.node)
             if node != agent.node:
                 self._enter_node(agent, node, i)
         self.player_moved = self.player.pos != before[-1]
@@ -269,18 +270,17 @@ class World(PlayerActions):
         """Vision, attack damage, distance and detection metrics for the current positions."""
         ppos = self.player.pos
         reach = self.view_reach()  # once per step, not once per guard
-        self.seen_by = self.team.detect(
-            self, tuple(i for i, g in enumerate(self.guards) if self.sees(g, ppos, reach)))
+        seeing, attackers, nodes, positions = _guard_senses(
+            self.guards, self.senses, ppos, reach, self.attack_range, self.attack_los)
+        self.seen_by = self.team.detect(self, tuple(seeing))
         if self.seen_by:
             self.sighting = self.player.node
             if self.m.first_detect_time is None:
                 self.m.first_detect_time = self.t
-        self.attackers = sum(1 for g in self.guards if g.active and self.senses.perceives(
-            g.pos, None, ppos, self.attack_range, line_of_sight=self.attack_los))
+        self.attackers = attackers
         if self.step_index > 0:
-            active = [g for g in self.guards if g.active]
-            self.m.sample_distance(self.graph, self.player.node, [g.node for g in active])
-            self.m.sample_euclidean(ppos, [g.pos for g in active])
+            self.m.sample_distance(self.graph, self.player.node, nodes)
+            self.m.sample_euclidean(ppos, positions)
 
     def _captured(self) -> None:
         self.m.count_capture(self.t)
@@ -336,6 +336,25 @@ class World(PlayerActions):
     def trace_record(self) -> dict[str, Any]:
         """One trace line (:func:`game.trace.trace_record`)."""
         return trace.trace_record(self)
+
+
+def _guard_senses(guards: list[Agent], senses: Senses, ppos: tuple[float, float], reach: float,
+                  attack_range: float, attack_los: bool
+                  ) -> tuple[list[int], int, list[int], list[tuple[float, float]]]:
+    """One pass over the active guards: which see the player (:meth:`World.sees`), how many
+    are in attack range, and their nodes and positions (the distance metrics' samples)."""
+    perceives = senses.perceives
+    seeing, attackers, nodes, positions = [], 0, [], []
+    for i, g in enumerate(guards):
+        if not g.active:
+            continue
+        if perceives(g.pos, g.heading, ppos, reach):
+            seeing.append(i)
+        if perceives(g.pos, None, ppos, attack_range, line_of_sight=attack_los):
+            attackers += 1
+        nodes.append(g.node)
+        positions.append(g.pos)
+    return seeing, attackers, nodes, positions
 
 
 def decision_interval(world: Mapping[str, Any], *, grid: bool) -> float:

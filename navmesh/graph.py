@@ -14,6 +14,7 @@ bit-identical whichever strategy a graph holds (tests/test_graph_queries.py chec
 
 from __future__ import annotations
 
+import math
 from collections.abc import Iterator, Sequence
 from dataclasses import dataclass, field
 from functools import cached_property, lru_cache
@@ -224,15 +225,22 @@ class NodeGraph:
     def node_at(self, x: float, y: float) -> int:
         """The node whose cell or triangle contains (x, y); the nearest node otherwise."""
         if self.cell_node is not None:
-            row, col = int(np.floor(y / self.cell_size)), int(np.floor(x / self.cell_size))
-            rows, cols = self.cell_node.shape
-            if 0 <= row < rows and 0 <= col < cols and self.cell_node[row, col] >= 0:
-                return int(self.cell_node[row, col])
+            # math.floor of the same quotient as np.floor, on Python lists: a numpy scalar
+            # round trip costs more than the rest of the lookup (an agent per physics step)
+            row, col = math.floor(y / self.cell_size), math.floor(x / self.cell_size)
+            cells = self._cell_rows
+            if 0 <= row < len(cells) and 0 <= col < len(cells[0]) and cells[row][col] >= 0:
+                return cells[row][col]
         elif self.mesh is not None:
             tri = self.mesh.locate(x, y)
             if tri >= 0:
                 return int(tri)
         return self.nearest_node(x, y)
+
+    @cached_property
+    def _cell_rows(self) -> list[list[int]]:
+        """``cell_node`` as nested Python lists (grid graphs only), for :meth:`node_at`."""
+        return np.asarray(self.cell_node).tolist()
 
     def node_near(self, x: float, y: float, hint: int) -> int:
         """:meth:`node_at` for a walker last seen on node ``hint`` (usually still there)."""

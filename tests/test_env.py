@@ -130,7 +130,7 @@ def test_a_grid_step_is_one_cell_and_stay_stays() -> None:
             assert math.isclose(world.t - before_t, 0.45)
         else:
             assert math.isclose(world.t - before_t, env.match.hold_steps * 0.05)
-        assert math.isclose(reward, 0.1 * (world.t - before_t))  # survival only
+        assert math.isclose(reward, REWARDS["survival"] * (world.t - before_t))  # survival only
     assert moved >= 2
 
 
@@ -142,7 +142,8 @@ def test_capture_ends_the_episode_with_the_penalty() -> None:
         _, r, term, trunc, info = env.step(0)  # a player that never moves
         total += r
     assert term and not trunc and info["captures"] == 1 and info["hp"] <= 0
-    assert math.isclose(total, 0.1 * info["t"] - 3.0 - 10.0, abs_tol=1e-6)
+    expected = REWARDS["survival"] * info["t"] - REWARDS["hp"] * 3.0 - REWARDS["capture"]
+    assert math.isclose(total, expected, abs_tol=1e-6)
 
 
 def test_guard_agents_move_as_told_and_see_fields() -> None:
@@ -205,7 +206,9 @@ def test_fixed_time_capture_respawns_and_counts_the_penalty() -> None:
         total += r
     assert not term and trunc and info["captures"] >= 1 and math.isclose(info["t"], 20.0)
     lost = 3.0 * info["captures"] + (3.0 - info["hp"])
-    assert math.isclose(total, 0.1 * 20.0 - lost - 10.0 * info["captures"], abs_tol=1e-6)
+    expected = (REWARDS["survival"] * 20.0 - REWARDS["hp"] * lost
+                - REWARDS["capture"] * info["captures"])
+    assert math.isclose(total, expected, abs_tol=1e-6)
 
 
 @pytest.mark.parametrize("action", [-1, 5, 1.7, "2", None, np.float64(1.0)])

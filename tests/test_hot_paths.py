@@ -130,3 +130,40 @@ def test_presence_equals_the_scipy_product_on_random_inputs() -> None:
             expected = _scipy_presence(m, mates, int(node))
             assert np.array_equal(m.presence(mates, int(node)), expected)  # the dense table
             assert np.array_equal(rows_only.presence(mates, int(node)), expected)  # per row
+
+
+@pytest.mark.parametrize("penalty", [0.7, 0.0])
+def test_dense_select_equals_the_array_select(penalty: float) -> None:
+    """CompositeField's Python-float decision on a dense graph == its array decision: the
+    same winner, the same score bits (signs of zero included), the same ties and draws."""
+    from ai.fields import CompositeField
+    from ai.params import PFParams
+    from navmesh.graph import NodeGraph
+
+    rng = np.random.default_rng(11)
+    for trial in range(12):
+        graph = NodeGraph.from_grid(rng.random((8, 11)) > 0.2, 1.0)
+        params = PFParams(revisit_penalty=penalty, teammate_presence=float(rng.uniform(0, 2)),
+                          tie_eps=float(rng.choice([1e-9, 0.05, 0.5])))
+        field = CompositeField(graph, params)
+        for _ in range(3):
+            field.tick(float(rng.uniform(0, 2)), rng.integers(graph.n, size=3),
+                       int(rng.integers(graph.n)) if rng.random() < 0.5 else None)
+        assert field.matrices.spreads.tables
+        for _ in range(25):
+            node = int(rng.integers(graph.n))
+            cands = field.matrices.candidates[node]
+            if not len(cands):
+                continue
+            mates = rng.integers(graph.n, size=int(rng.integers(0, 4)))
+            recent = [int(x) for x in rng.choice(cands, size=min(len(cands), 2))] + [node]
+            personal = rng.normal(size=graph.n) if rng.random() < 0.3 else None
+            seed = int(rng.integers(2**31))
+            a_rng, b_rng = np.random.default_rng(seed), np.random.default_rng(seed)
+            a = field._select_dense(cands, a_rng, mates, recent, personal)
+            b = field._select_arrays(node, cands, b_rng, mates, recent, personal)
+            assert a is not None and a.winner == b.winner
+            assert np.array_equal(a.scores, b.scores)
+            assert np.array_equal(np.signbit(a.scores), np.signbit(b.scores))
+            assert np.array_equal(a.tied, b.tied) and a.tied.dtype == b.tied.dtype
+            assert a_rng.integers(2**62) == b_rng.integers(2**62)

@@ -69,6 +69,11 @@ def check_action(space: spaces.Discrete, action: Any, who: str = "the agent") ->
     ``Discrete.contains`` refuses floats, strings and out-of-range integers (numpy's
     ``-1`` included), so ``step(1.7)`` cannot silently become action 1.
     """
+    kind = type(action)
+    if kind is int or kind is np.int64:  # the usual cases, without contains()'s dtype checks
+        start = int(space.start)
+        if start <= action < start + int(space.n):
+            return int(action)
     try:
         ok = space.contains(action)
     except (TypeError, ValueError):

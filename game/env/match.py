@@ -39,7 +39,10 @@ PARTITION_ACTIONS = ("stay", "north", "northeast", "east", "southeast",
 #: player, ``proximity`` for a guard on the player's node, falling linearly to 0 at the
 #: guards' view range along the level's paths. A potential's change sums to its last
 #: value minus its first over an episode, so shaping never pays a player to die sooner.
-REWARDS = {"survival": 0.1, "hp": 1.0, "capture": 10.0, "seen": 2.0, "proximity": 6.0}
+#: One per second survived makes the game's part of the return the capture scenario's own
+#: score, seconds survived, less 1 per HP and 3 per capture (what the fixed-time scenario,
+#: whose clock always runs out, scores); a step is worth about ±0.5 (issue 23).
+REWARDS = {"survival": 1.0, "hp": 1.0, "capture": 3.0, "seen": 1.0, "proximity": 3.0}
 
 
 def _direction_table(graph: NodeGraph) -> np.ndarray:
@@ -166,6 +169,9 @@ class Match:
         #: physics steps a "stay" lasts: as long as a move along a mean edge takes
         self.hold_steps = max(1, math.ceil(self.graph.mean_edge_length / speed / self.dt - 1e-9))
         self.max_steps = max(self.hold_steps, math.ceil(2 * float(cfg["world.stuck_timeout"]) / self.dt))
+        self.ends_on_capture = bool(cfg[f"scenario.{scenario}.end_on_capture"])
+        #: node positions as Python floats (the same values as the graph's rows)
+        self._points: list[list[float]] = self.graph.positions.tolist()
 
         self.seed: int | None = None
         self.world = self._new_world(0)
@@ -231,7 +237,10 @@ class Match:
         """Path distance from the player's node to the nearest active guard's (inf if none)."""
         w = self.world
         nodes = [g.node for g in w.guards if g.active]
-        return self.graph.nearest_dist_to(nodes, w.player.node) if nodes else math.inf
+        if not nodes:
+            return math.inf
+        cached = w.m.cached_distance(w.player.node, nodes)  # the distance metric's, if current
+        return self.graph.nearest_dist_to(nodes, w.player.node) if cached is None else cached
 
     def step(self, player_action: int, guard_actions: np.ndarray | None = None
              ) -> tuple[float, bool, bool]:
@@ -259,7 +268,7 @@ class Match:
                 elif self.player.decisions > 1 or self._at(self.player.target):
                     break
         captures = w.m.captures - caps0
-        ends = bool(self.config[f"scenario.{self.scenario}.end_on_capture"])
+        ends = self.ends_on_capture
         if captures and not ends:  # fixed-time: the player respawned with full HP
             lost = hp0 + (captures - 1) * self.hp_max + (self.hp_max - w.hp)
         else:
@@ -273,7 +282,7 @@ class Match:
 
     def _at(self, node: int) -> bool:
         x, y = self.world.player.pos
-        px, py = self.graph.positions[node]
+        px, py = self._points[node]
         return math.hypot(x - px, y - py) <= 1e-3
 
     # ------------------------------------------------------------------ rendering

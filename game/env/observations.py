@@ -118,12 +118,37 @@ class Observer:
                 out += [0.0] * len(OTHER_GUARD)
         return out
 
+    def perceived(self, view: WorldView) -> list[int]:
+        """The guards the player perceives (:meth:`player_sees` of each), one shapely call
+        for every line of sight."""
+        a = view.player_pos
+        active = active_guards(view)
+        candidates, lines = [], []
+        for j, b in enumerate(view.guard_positions):
+            if not active[j]:
+                continue
+            d = math.dist(a, b)
+            if d > self.view_range:
+                continue
+            candidates.append(j)
+            lines.append(None if d < 1e-9 else (a, b))
+        if not candidates:
+            return []
+        need = [k for k, line in enumerate(lines) if line is not None]
+        if need:
+            clear = shapely.covers(self.walkable, shapely.linestrings(
+                np.array([lines[k] for k in need], dtype=np.float64)))
+            for k, ok in zip(need, clear.tolist(), strict=True):
+                if not ok:
+                    candidates[k] = -1
+        return [j for j in candidates if j >= 0]
+
     def observe_player(self, world: World, view: WorldView) -> np.ndarray:
         """The player's observation (layout: docs/api.md, "Observations")."""
         pos = view.player_pos
         win, row, col = self._window(pos, len(PLAYER_CHANNELS))
         self._mark(win, 1, row, col, pos)
-        known = [j for j in range(self.n_guards) if self.player_sees(view, j)]
+        known = self.perceived(view)
         for j in known:
             self._mark(win, 2, row, col, view.guard_positions[j])
         heading = world.player.heading
@@ -147,11 +172,11 @@ class Observer:
         cap = 2.0 * scale
         if known:
             near = self.graph.nearest_dist(view.guard_nodes[known], limit=cap)[targets]
-            safety = np.minimum(near, cap) / cap
+            safety = (np.minimum(near, cap) / cap).tolist()
         else:
-            safety = np.ones(len(targets))
-        for a, target in enumerate(targets):
-            vec += [float(a == 0 or target != node), float(safety[a])]
+            safety = [1.0] * len(targets)
+        for a, target in enumerate(targets.tolist()):
+            vec += [float(a == 0 or target != node), safety[a]]
         return self._pack(win, vec)
 
     def observe_guard(self, world: World, view: WorldView, i: int,
@@ -183,8 +208,13 @@ class Observer:
 
     @staticmethod
     def _pack(win: np.ndarray, vec: list[float]) -> np.ndarray:
-        out = np.concatenate([win.ravel(), np.asarray(vec, dtype=np.float32)])
-        return np.clip(out, -OBS_BOUND, OBS_BOUND).astype(np.float32)
+        """The window then the features, as float32 clipped to ±OBS_BOUND (each feature is
+        rounded to float32 first, then clipped, as one concatenated array would be)."""
+        side = win.size
+        out = np.empty(side + len(vec), dtype=np.float32)
+        out[:side] = win.ravel()
+        out[side:] = vec
+        return np.clip(out, -OBS_BOUND, OBS_BOUND, out=out)
 
     def obs_size(self, guard: bool) -> int:
         side = (2 * self.radius + 1) ** 2
