@@ -19,3 +19,18 @@ if "STEALTHFIELD_DATA" not in os.environ:
     import tempfile
 
     os.environ["STEALTHFIELD_DATA"] = tempfile.mkdtemp(prefix="stealthfield-data-")
+
+
+import pytest  # noqa: E402
+
+
+@pytest.fixture(autouse=True)
+def _zone_kinds_restored():
+    """A test that loads a stimulus plugin registers its zone kinds process-wide; the next
+    test in the same worker must still see only the built-in kinds (test order varies with
+    pytest-xdist's scheduling)."""
+    from navmesh import level_fields
+
+    kinds = list(level_fields._zone_kinds)
+    yield
+    level_fields._zone_kinds[:] = kinds
