@@ -133,16 +133,21 @@ def test_the_overlay_computed_on_a_thread_is_the_synchronous_one() -> None:
     assert np.array_equal(scene.layer.norm, now.layer.norm)
 
 
-def test_a_layer_composed_in_stripes_has_the_pixels_of_one_composed_at_once() -> None:
+def _arkham_layers(seed: int, count: int) -> tuple[StaticLayers, StaticLayers, list[FieldLayer]]:
+    """Arkham's grid drawn once at once and once in 4 stripes, and ``count`` random K layers."""
     init_pygame()
     pygame.display.set_mode((320, 240))
     level = load_level("arkham")
     graph = graph_for(level, "grid")
     static = StaticScene.from_level(level, graph)
-    rng = np.random.default_rng(4)
-    first, second = (FieldLayer.from_values("K", rng.normal(size=graph.n)) for _ in range(2))
+    rng = np.random.default_rng(seed)
+    fields = [FieldLayer.from_values("K", rng.normal(size=graph.n)) for _ in range(count)]
+    return StaticLayers(static), StaticLayers(static, stripes=4), fields
+
+
+def test_a_layer_composed_in_stripes_has_the_pixels_of_one_composed_at_once() -> None:
+    at_once, striped, (first, second) = _arkham_layers(4, 2)
     visible = (2.0, 2.0, 14.0, 11.0)
-    at_once, striped = StaticLayers(static), StaticLayers(static, stripes=4)
     for layers in (at_once, striped):
         layers.surface(visible, 20.0, first, False)
     want = pygame.surfarray.array3d(at_once.surface(visible, 20.0, second, False)[0])
@@ -151,6 +156,25 @@ def test_a_layer_composed_in_stripes_has_the_pixels_of_one_composed_at_once() ->
     before = pygame.surfarray.array3d(at_once.surface(visible, 20.0, first, False)[0])
     assert all(np.array_equal(s, before) for s in shown[:3])  # the old layer until complete
     assert np.array_equal(shown[3], want) and not np.array_equal(want, before)
+
+
+
+def test_a_stripe_count_changed_between_layers_keeps_the_pixels() -> None:
+    at_once, striped, layers_k = _arkham_layers(5, 3)
+    visible = (2.0, 2.0, 14.0, 11.0)
+    assert striped.striped and not at_once.striped
+    for layers in (at_once, striped):
+        layers.surface(visible, 20.0, layers_k[0], False)
+    assert striped.compose_cost > 0
+    for layer, count in ((layers_k[1], 2), (layers_k[2], 5)):
+        striped.stripes = count
+        want = pygame.surfarray.array3d(at_once.surface(visible, 20.0, layer, False)[0])
+        shown = []
+        for k in range(count):
+            shown.append(pygame.surfarray.array3d(striped.surface(visible, 20.0, layer, False)[0]))
+            striped.stripes = 3  # a change while composing applies to the next layer only
+        assert all(not np.array_equal(s, want) for s in shown[:-1])
+        assert np.array_equal(shown[-1], want)
 
 
 class _SlowWorker:

@@ -153,38 +153,3 @@ def test_a_ball_is_queued_once_and_a_guards_node_goes_first() -> None:
     prefetch.expect(10)  # kept already: nothing to search
     assert not prefetch.ahead
 
-
-# ---------------------------------------------------------------------------- the layers
-
-
-def test_a_stripe_count_changed_between_layers_keeps_the_pixels() -> None:
-    import pygame
-
-    from game.front.layers import StaticLayers
-    from game.front.render import init_pygame
-    from game.scene import FieldLayer, StaticScene
-    from navmesh.graph import graph_for
-    from navmesh.level import load_level
-
-    init_pygame()
-    pygame.display.set_mode((320, 240))
-    level = load_level("arkham")
-    graph = graph_for(level, "grid")
-    static = StaticScene.from_level(level, graph)
-    rng = np.random.default_rng(5)
-    layers_k = [FieldLayer.from_values("K", rng.normal(size=graph.n)) for _ in range(3)]
-    visible = (2.0, 2.0, 14.0, 11.0)
-    at_once, striped = StaticLayers(static), StaticLayers(static, stripes=4)
-    assert striped.striped and not at_once.striped
-    for layers in (at_once, striped):
-        layers.surface(visible, 20.0, layers_k[0], False)
-    assert striped.compose_cost > 0
-    for layer, count in ((layers_k[1], 2), (layers_k[2], 5)):
-        striped.stripes = count
-        want = pygame.surfarray.array3d(at_once.surface(visible, 20.0, layer, False)[0])
-        shown = []
-        for k in range(count):
-            shown.append(pygame.surfarray.array3d(striped.surface(visible, 20.0, layer, False)[0]))
-            striped.stripes = 3  # a change while composing applies to the next layer only
-        assert all(not np.array_equal(s, want) for s in shown[:-1])
-        assert np.array_equal(shown[-1], want)
