@@ -372,12 +372,10 @@ class CompositeField:
                 for value in row[1:]:
                     total += value
                 scores[j] += scale * total
-        revisit = self.w_C * p.revisit_penalty * p.C0  # revisit_term, inline
-        if len(recent) and revisit:
-            found = set(np.asarray(recent).tolist()) if isinstance(recent, np.ndarray) else set(recent)
-            hit, miss = revisit * 1.0, revisit * 0.0
-            for j, c in enumerate(cands):
-                scores[j] += hit if c in found else miss
+        revisit = self.revisit_term(candidates, recent)
+        if revisit is not None:
+            for j, value in enumerate(revisit.tolist()):
+                scores[j] += value
         if personal is not None:
             for j, value in enumerate(personal[candidates].tolist()):
                 scores[j] += value
