@@ -81,6 +81,11 @@ class FieldMatrices:
             return np.zeros(self.graph.n)
         return self.spreads.deposit(nodes)
 
+    def deposit_into(self, target: np.ndarray, nodes: np.ndarray, scale: float) -> None:
+        """``target += scale * deposit(nodes)`` in place, bit for bit ``target + scale *
+        deposit(nodes)`` (the tick adds into the decayed C it has just made)."""
+        self.spreads.deposit_into(target, np.asarray(nodes, dtype=np.intp), scale)
+
     def deposit_at(self, nodes: Sequence[int] | np.ndarray, at: np.ndarray) -> np.ndarray:
         """``deposit(nodes)[at]``, summed in the same order, from the balls alone."""
         nodes = np.asarray(nodes, dtype=np.intp)

@@ -40,6 +40,7 @@ from scipy import sparse
 from navmesh.graph import NodeGraph
 
 from .candidates import CandidateSets, candidate_sets
+from .decay_ahead import DecayAhead
 from .field_matrices import FieldMatrices, field_matrices
 from .kernel import kernel_matrix
 from .params import PFParams
@@ -128,6 +129,9 @@ class CompositeField:
         self._extra = zeros
         self._confidence_decay = read_only(np.full(n, self.params.rho))
         self._decay_cache: tuple[float, np.ndarray, np.ndarray] | None = None
+        #: the next tick's decayed I and C, being computed ahead (:meth:`work_ahead`)
+        self._ahead: DecayAhead | None = None
+        self._last_dt = 0.0
         self._w_I_floor = 0.0
         self._set_w_I(self.params.w_I_base)
         self.ticks = 0
@@ -233,22 +237,48 @@ class CompositeField:
         if dt < 0:
             raise ValueError(f"dt must be >= 0, got {dt}")
         p, m = self.params, self.matrices
+        rho_dt, decay = p.rho**dt, self._decay_power(dt)
+        ahead, self._ahead = self._ahead, None
+        if ahead is not None and ahead.matches(dt, self._information, rho_dt,
+                                               self._confidence, decay):
+            decayed_information, confidence = ahead.result()
+        else:
+            decayed_information = None
+            confidence = self._confidence * decay
         if sighting_node is not None:
             information = -p.I0 * m.info_spread(sighting_node)
             self._set_w_I(p.w_I_max)
         else:
-            information = self._information * (p.rho**dt)
+            information = (self._information * rho_dt if decayed_information is None
+                           else decayed_information)
             self._set_w_I(max(p.w_I_base, self.w_I - p.weight_decay * dt))
         if self.w_I < self._w_I_floor:
             self._set_w_I(self._w_I_floor)
-        confidence = self._confidence * self._decay_power(dt)
         guards = np.asarray(guard_nodes, dtype=np.intp)
         if len(guards):
-            confidence = confidence + p.C0 * m.deposit(guards)
+            m.deposit_into(confidence, guards, p.C0)  # C · decay^dt + C0 Σ_g γ_C^d(g, ·)
+        if dt > 0:
+            self._last_dt = dt
         self._information = read_only(information)
         self._confidence = read_only(confidence)
         self.ticks += 1
         self._version += 1
+
+    def work_ahead(self, deadline: float) -> bool:
+        """Compute the next tick's ``I · ρ^dt`` and ``C · decay^dt`` until ``deadline``
+        (``time.perf_counter()``), a slice at a time (:class:`~ai.decay_ahead.DecayAhead`),
+        for a tick as long as the last; whether work is left. Changes no result: the tick
+        uses them only if made from the arrays it would multiply."""
+        dt = self._last_dt
+        if dt <= 0:
+            return False  # no tick yet to take the length from
+        rho_dt, decay = self.params.rho**dt, self._decay_power(dt)
+        ahead = self._ahead
+        if ahead is None or not ahead.matches(dt, self._information, rho_dt,
+                                              self._confidence, decay):
+            ahead = self._ahead = DecayAhead(dt, self._information, rho_dt,
+                                             self._confidence, decay)
+        return ahead.run(deadline)
 
     def _decay_power(self, dt: float) -> np.ndarray:
         """``confidence_decay ** dt``, cached for the last dt (ticks are usually all 1 s)."""

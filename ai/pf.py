@@ -7,6 +7,7 @@ candidate set; ``explain`` says why, in plain JSON-able types.
 
 from __future__ import annotations
 
+import time
 from collections import deque
 from collections.abc import Callable, Hashable, Mapping, Sequence
 from dataclasses import dataclass
@@ -228,8 +229,12 @@ class PotentialFieldGuards(GuardAI):
         return self.field.fields()
 
     def prepare(self, budget: float) -> bool:
-        """The guards' next nodes' spreads ahead, for about ``budget`` s (:meth:`Prefetch.run`)."""
-        return self.prefetch.run(budget)
+        """Work ahead for about ``budget`` s: the next tick's decayed fields
+        (:meth:`CompositeField.work_ahead`), then the guards' next nodes' spreads
+        (:meth:`Prefetch.run`)."""
+        deadline = time.perf_counter() + budget
+        fields_left = self.field.work_ahead(deadline)
+        return self.prefetch.run(max(0.0, deadline - time.perf_counter())) or fields_left
 
     def expect(self, nodes: Sequence[int]) -> None:
         """The confidence balls of ``nodes`` first in the work-ahead queue: the next tick

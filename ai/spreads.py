@@ -79,6 +79,14 @@ class Spreads:
         """(n,) ``Σ_g γ_C ** d(g, ·)`` over the (non-empty) ``nodes``, summed in their order."""
         raise NotImplementedError
 
+    def deposit_into(self, target: np.ndarray, nodes: np.ndarray, scale: float) -> None:
+        """``target += scale * deposit(nodes)`` in place, the same bits as ``target + scale *
+        deposit(nodes)`` without two of its three (n,) temporaries (measured on a 10^6-cell
+        level: a sparse sum over the balls' nodes alone costs more than these dense passes)."""
+        total = self.deposit(nodes)  # a new row, ours to scale
+        np.multiply(total, scale, out=total)
+        np.add(target, total, out=target)
+
     # searching ahead (:mod:`ai.prefetch`); a strategy that keeps rows needs none
     def wanted(self, which: str, node: int) -> bool:
         """Whether the ball of ``which`` at ``node`` would be searched when first read."""

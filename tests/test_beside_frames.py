@@ -18,6 +18,7 @@ import numpy as np
 import pygame
 from scipy.sparse.csgraph import dijkstra
 
+from ai.decay_ahead import DecayAhead
 from ai.fields import CompositeField, FieldMatrices
 from ai.params import PFParams
 from ai.prefetch import Prefetch
@@ -91,6 +92,41 @@ def test_a_field_snapshot_computes_the_fields_of_its_moment() -> None:
     assert set(later) == set(expected)
     assert all(np.array_equal(later[k], expected[k]) for k in expected)
     assert snapshot.identity != field.snapshot().identity
+
+
+def test_fields_decayed_ahead_tick_to_the_same_bits(monkeypatch) -> None:  # type: ignore[no-untyped-def]
+    """The next tick's I · ρ^dt and C · decay^dt computed ahead (whole, a slice at a time,
+    or begun from arrays a tick has since replaced) give the fields of a tick that
+    multiplies them itself, and the arrays handed out before stay as they were."""
+    monkeypatch.setattr(DecayAhead, "SLICE", 97)  # a dozen slices on this graph
+    graph = _sparse_grid(3)
+    now, ahead = CompositeField(graph), CompositeField(graph)
+    ahead_slices = ahead._ahead  # none before the first tick: no length to take
+    assert ahead_slices is None and not ahead.work_ahead(time.perf_counter() + 10.0)
+    script = [([5, 60], 200), ([6, 61], None), ([6, 62], None), ([7, 62], 90), ([8, 63], None),
+              ([8, 64], None), ([9, 64], None)]
+    for step, (guards, sighting) in enumerate(script):
+        before = {k: v.copy() for k, v in ahead.fields().items()}
+        handed_out = ahead.fields()
+        if step % 3 == 1:
+            assert not ahead.work_ahead(time.perf_counter() + 10.0)  # all of it
+        elif step % 3 == 2:
+            ahead.work_ahead(0.0)  # begun, nothing filled: the tick finishes it
+            assert ahead._ahead is not None and ahead._ahead.done == 0
+            ahead.work_ahead(time.perf_counter() + 1e-5)  # perhaps a slice or two
+        now.tick(1.0, guards, sighting)
+        ahead.tick(1.0, guards, sighting)
+        assert all(np.array_equal(handed_out[k], before[k]) for k in before)
+        for name, value in now.fields().items():
+            assert np.array_equal(value, ahead.fields()[name]), (step, name)
+    # begun from the fields before a tick that then did not use it: dropped, not read later
+    ahead.work_ahead(time.perf_counter() + 10.0)
+    stale = ahead._ahead
+    ahead.tick(0.5, [9], None)  # another length: multiplied here, the work ahead dropped
+    now.tick(0.5, [9], None)
+    assert ahead._ahead is None and stale is not None
+    assert np.array_equal(now.confidence, ahead.confidence)
+    assert np.array_equal(now.information, ahead.information)
 
 
 def _worlds(steps: int, worker: DistanceWorker | None, spec: TrialSpec) -> dict:
