@@ -114,6 +114,37 @@ def test_without_an_audio_device_the_game_plays_silently(tmp_path: Path) -> None
     assert "Traceback" not in result.stderr and "error" not in result.stderr.lower()
 
 
+def test_no_sound_card_and_no_sound_server_means_no_mixer_and_no_lines() -> None:
+    """On Linux with no driver asked for, no /dev/snd and no sound server, the board does
+    not try the device (ALSA would print a dozen lines); anything else is tried."""
+    from game.front.sound import audio_device_likely
+
+    def nothing(path: str) -> bool:
+        return False
+
+    bare = {"XDG_RUNTIME_DIR": "/run/user/1000"}
+    if sys.platform.startswith("linux"):
+        assert not audio_device_likely(bare, nothing)
+        assert audio_device_likely(bare, lambda path: path == "/dev/snd")
+        assert audio_device_likely(bare, lambda path: path == "/run/user/1000/pulse/native")
+        assert audio_device_likely(bare, lambda path: path == "/run/user/1000/pipewire-0")
+        assert not audio_device_likely({}, lambda path: path.endswith("/pulse/native"))
+    assert audio_device_likely({**bare, "SDL_AUDIODRIVER": "dummy"}, nothing)
+    assert audio_device_likely({**bare, "PULSE_SERVER": "tcp:host"}, nothing)
+    if sys.platform.startswith("linux") and not os.path.exists("/dev/snd"):
+        # this machine has no card: the whole game says nothing of audio on stderr
+        code = ("from game.front.play import PlayGame, PlaySettings\n"
+                "g = PlayGame(PlaySettings('miami'), lockstep=True, size=(320, 240))\n"
+                "g.run(5)\nassert not g.sound.available\ng.close()\n")
+        env = {k: v for k, v in os.environ.items()
+               if k not in ("SDL_AUDIODRIVER", "PULSE_SERVER", "XDG_RUNTIME_DIR")}
+        env["SDL_VIDEODRIVER"] = "dummy"
+        result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                                env=env, timeout=120)
+        assert result.returncode == 0, result.stderr
+        assert "ALSA" not in result.stderr and "audio" not in result.stderr.lower()
+
+
 def test_the_paused_sign_shows_over_the_ready_screen(monkeypatch: pytest.MonkeyPatch) -> None:
     titles: list[str] = []
     real = render_module.draw_panel

@@ -18,8 +18,10 @@ Without an audio device (no sound card, or SDL cannot open one) the board is sil
 
 from __future__ import annotations
 
+import os
+import sys
 from collections import Counter
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 
 import numpy as np
 import pygame
@@ -239,11 +241,27 @@ def _open_mixer() -> bool:
     """Open the audio device once; False (silence) when there is none."""
     if pygame.mixer.get_init():
         return True
+    if not audio_device_likely():
+        return False  # else ALSA prints a dozen lines of its own before SDL gives up
     try:
         pygame.mixer.init(frequency=RATE, size=-16, channels=1, buffer=512)
     except pygame.error:
         return False
     return bool(pygame.mixer.get_init())
+
+
+def audio_device_likely(environ: Mapping[str, str] | None = None,
+                        exists: Callable[[str], bool] = os.path.exists) -> bool:
+    """Whether SDL may find an audio device: always, unless on Linux with no driver asked
+    for (``SDL_AUDIODRIVER``), no sound card (``/dev/snd``) and no sound server's socket
+    (PulseAudio, PipeWire; ``PULSE_SERVER``) — then opening one only fills the terminal."""
+    environ = os.environ if environ is None else environ
+    if not sys.platform.startswith("linux") or environ.get("SDL_AUDIODRIVER") \
+            or environ.get("PULSE_SERVER"):
+        return True
+    runtime = environ.get("XDG_RUNTIME_DIR", "")
+    servers = [f"{runtime}/pulse/native", f"{runtime}/pipewire-0"] if runtime else []
+    return any(exists(path) for path in ["/dev/snd", *servers])
 
 
 def _make_sound(kind: str) -> pygame.mixer.Sound:
