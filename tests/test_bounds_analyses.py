@@ -56,8 +56,10 @@ def _run(module: str, *args: Path | str) -> subprocess.CompletedProcess[str]:
                           capture_output=True, text=True, timeout=60, env=env, cwd=ROOT)
 
 
+# paired and held_out on a finished store give a correct result (tested below), not an error
 CASES = [(m, k) for m in ("held_out", "robustness", "beside_paper", "paired")
-         for k in ("store", "garbage", "empty", "tables", "none")]
+         for k in ("store", "garbage", "empty", "tables", "none")
+         if not (k == "store" and m in ("paired", "held_out"))]
 
 
 @pytest.mark.parametrize(("module", "kind"), CASES)
@@ -65,8 +67,6 @@ def test_an_analysis_on_a_bad_input_is_one_line(module: str, kind: str,
                                                  stores: dict[str, Path]) -> None:
     folder = stores[kind]
     args = (folder, stores["store"]) if module == "paired" else (folder,)
-    if kind == "store" and module in ("paired", "held_out"):
-        pytest.skip("on a finished store these give a correct result (tested below)")
     before = (folder / "results.sqlite").read_bytes() if (folder / "results.sqlite").is_file() else None
     done = _run(module, *args)
     assert done.returncode == 2, (done.stdout, done.stderr)
