@@ -91,13 +91,14 @@ def main() -> None:
     results = {name: play(env, policy, seeds) for name, policy in players.items()}
     eval_s = time.perf_counter() - start
 
-    print(f"{args.level}, grid, capture, PF guards; PPO {args.steps} steps in {train_s:.0f} s; "
-          f"held-out seeds 0-{args.test_seeds - 1} ({eval_s:.0f} s)")
+    # SB3 trains whole rollouts (2 envs x 2,048 steps): 60,000 asked are 61,440 trained
+    print(f"{args.level}, grid, capture, PF guards; PPO {model.num_timesteps} steps in "
+          f"{train_s:.0f} s; held-out seeds 0-{args.test_seeds - 1} ({eval_s:.0f} s)")
     print(f"{'player':8} {'survival s':>10} {'capture rate':>12} {'return':>8}")
     for name, r in results.items():
         print(f"{name:8} {r['survival'].mean():10.2f} {r['captured'].mean():12.2f} "
               f"{r['return'].mean():8.2f}")
-    summary: dict[str, object] = {"level": args.level, "steps": args.steps,
+    summary: dict[str, object] = {"level": args.level, "steps": model.num_timesteps,
                                   "train_seconds": round(train_s, 1),
                                   "players": {k: {m: round(float(v.mean()), 3) for m, v in r.items()}
                                               for k, r in results.items()}}

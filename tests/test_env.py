@@ -326,3 +326,14 @@ def test_supersuit_vectorises_the_parallel_env_as_it_is() -> None:
     for _ in range(15):
         obs, rewards, *_ = venv.step(np.zeros(6, dtype=np.int64))
     assert rewards.shape == (6,)
+
+
+def test_supersuit_copies_of_a_new_env_play_their_own_seeds() -> None:
+    """SuperSuit pickles one copy of the env per vector slot before any reset, and SB3 resets
+    them seedless (its SuperSuit wrapper cannot seed): each copy draws its own first seed."""
+    supersuit = pytest.importorskip("supersuit")
+    env = parallel_env("maze", world__guards=2, world__duration=3.0)
+    venv = supersuit.concat_vec_envs_v1(supersuit.pettingzoo_env_to_vec_env_v1(env), 2,
+                                        num_cpus=0, base_class="gymnasium")
+    _, infos = venv.reset()
+    assert infos[0]["seed"] != infos[3]["seed"]  # rows 0 and 3: the two copies' players

@@ -117,7 +117,11 @@ class StealthParallelEnv(ParallelEnv):
         self._obs_spaces = {a: self.match.obs_space(a != "player", self._sizes[a])
                             for a in self.possible_agents}
         self._act_spaces = {a: spaces.Discrete(self.match.n_actions) for a in self.possible_agents}
-        self._fallback = np.random.default_rng()
+        #: where the first seedless reset's seed comes from; made at the first reset, not
+        #: here, so that copies of a new env (SuperSuit's vector wrappers pickle one per
+        #: copy, then SB3 resets them seedless) draw seeds of their own: copies of one
+        #: generator all drew the same seed and played the same episodes
+        self._fallback: np.random.Generator | None = None
 
     def observation_space(self, agent: str) -> spaces.Box:
         return self._obs_spaces[agent]
@@ -155,6 +159,8 @@ class StealthParallelEnv(ParallelEnv):
 
     def reset(self, seed: int | None = None, options: dict | None = None
               ) -> tuple[dict[str, np.ndarray], dict[str, dict]]:
+        if self._fallback is None:  # made at the first reset (OS entropy): see __init__
+            self._fallback = np.random.default_rng()
         self.match.reset(seed, self._fallback)
         self.agents = list(self.possible_agents)
         return self._observe(), self._infos()
