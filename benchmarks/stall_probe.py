@@ -9,7 +9,10 @@ generated levels and reports every guard stand-still longer than ``--min`` secon
 its controller did not choose: the body's position is exactly unchanged from one physics
 step to the next while it does not stand on its target with no waypoints left (the rule of
 tests/test_bounds_geometry.py). A "creep" is the looser figure: the body stays within
-0.02 units of where the stand began (a body pushed against a wall jitters).
+0.02 units of where the stand began (a body pushed against a wall jitters). A "restless"
+stand is still too, but its controller re-decides at every step: each target's stand
+point is where the body already is (nodes a body cannot enter, sharing one stand point),
+so every decision counts as arrived at once.
 
 Level kinds (both 12 x 8 rooms, regenerated until a body of the agent radius reaches the
 whole walkable area):
@@ -20,8 +23,8 @@ whole walkable area):
   so routes between the two sides must turn around its free end.
 
 Prints one line per stand (level, mode, seed, guard, start time, length, position, node,
-target, waypoints, whether the plan was a re-plan) and a summary of the longest stand per
-mode. Determinism: a level is a pure function of (kind, index), a trial of its seed.
+target, waypoints, whether the plan was a re-plan), one per restless stand, and the
+longest of each figure per level kind and mode. Determinism: a level is a pure function of (kind, index), a trial of its seed.
 """
 
 from __future__ import annotations
@@ -128,11 +131,12 @@ class Job:
     minimum: float
 
 
-def run(job: Job) -> tuple[Job, list[dict], dict[str, float]]:
-    """Every unwanted stand of one trial longer than ``job.minimum``, and the trial's
-    longest figures: ``stand`` (unwanted, exact), ``creep`` (unwanted, within
-    :data:`CREEP`) and ``restless`` (exactly still while the controller's target changed
-    at least once, wanted or not: instant arrivals a controller keeps re-deciding)."""
+def run(job: Job) -> tuple[Job, list[dict], list[dict], dict[str, float]]:
+    """Every unwanted stand and every restless stand of one trial longer than
+    ``job.minimum``, and the trial's longest figures: ``stand`` (unwanted, exact),
+    ``creep`` (unwanted, within :data:`CREEP`) and ``restless`` (exactly still while the
+    controller's target changed at least once, each target reached at once: the
+    controller hops between nodes a body cannot tell apart)."""
     level = KINDS[job.kind](job.index)
     config = Config.load({"world.duration": job.duration})
     world = World(level, job.abstraction, make_guard_ai(job.mode, config.section(job.mode)),
@@ -146,6 +150,8 @@ def run(job: Job) -> tuple[Job, list[dict], dict[str, float]]:
     last = [g.pos for g in guards]
     start: list[dict | None] = [None] * n
     found: list[dict] = []
+    hops: list[dict] = []
+    where = [g.pos for g in guards]
     worst = {"stand": 0.0, "creep": 0.0, "restless": 0.0}
 
     def off(node: int) -> bool:
@@ -156,6 +162,11 @@ def run(job: Job) -> tuple[Job, list[dict], dict[str, float]]:
     def close(k: int) -> None:
         if start[k] is not None and still[k] > job.minimum:
             found.append({**start[k], "length": still[k]})  # type: ignore[dict-item]
+
+    def close_hop(k: int) -> None:
+        if len(targets[k]) > 1 and quiet[k] > job.minimum:
+            hops.append({"guard": k, "t": world.t - quiet[k], "length": quiet[k],
+                         "pos": where[k], "targets": sorted(targets[k])})
 
     while not world.done:
         world.step()
@@ -178,7 +189,8 @@ def run(job: Job) -> tuple[Job, list[dict], dict[str, float]]:
                 quiet[k] += dt
                 targets[k].add(g.target)
             else:
-                quiet[k], targets[k] = 0.0, {g.target}
+                close_hop(k)
+                quiet[k], targets[k], where[k] = 0.0, {g.target}, g.pos
             worst["stand"] = max(worst["stand"], still[k])
             worst["creep"] = max(worst["creep"], creep[k])
             if len(targets[k]) > 1:
@@ -186,7 +198,8 @@ def run(job: Job) -> tuple[Job, list[dict], dict[str, float]]:
             last[k] = g.pos
     for k in range(n):
         close(k)
-    return job, found, worst
+        close_hop(k)
+    return job, found, hops, worst
 
 
 def main() -> None:
@@ -207,10 +220,12 @@ def main() -> None:
             for mode in args.modes.split(",") for seed in range(args.seeds)]
     began = time.perf_counter()
     stands: list[tuple[Job, dict]] = []
+    restless: list[tuple[Job, dict]] = []
     worst: dict[tuple[str, str], dict[str, float]] = {}
     with ProcessPoolExecutor(args.jobs) as pool:
-        for job, found, figures in pool.map(run, jobs, chunksize=2):
+        for job, found, hops, figures in pool.map(run, jobs, chunksize=2):
             stands += [(job, f) for f in found]
+            restless += [(job, h) for h in hops]
             row = worst.setdefault((job.kind, job.mode), dict.fromkeys(figures, 0.0))
             for name, value in figures.items():
                 row[name] = max(row[name], value)
@@ -227,6 +242,14 @@ def main() -> None:
     offs = sum(1 for _, f in stands if f["off"])
     print(f"stands with waypoints left: {planned}; whose target's stand point lies outside "
           f"the target's triangle: {offs}")
+    restless.sort(key=lambda s: -s[1]["length"])
+    print(f"restless stands > {args.minimum:g} s (still, the controller re-deciding): "
+          f"{len(restless)}")
+    for job, h in restless[:args.show]:
+        print(f"  {job.kind}{job.index} {job.mode} seed {job.seed} guard {h['guard']}: "
+              f"{h['length']:.2f} s from t={h['t']:.2f} at ({h['pos'][0]:.3f}, "
+              f"{h['pos'][1]:.3f}), targets {h['targets'][:8]}"
+              f"{' ...' if len(h['targets']) > 8 else ''}")
     print("longest per level kind and mode (s):\n  kind   mode       stand  creep restless")
     for (kind, mode), row in sorted(worst.items()):
         print(f"  {kind:6s} {mode:9s} {row['stand']:6.2f} {row['creep']:6.2f} "
