@@ -239,9 +239,20 @@ class World(PlayerActions):
 
         settle, node_near, last = walk.settle, self.graph.node_near, len(agents) - 1  # player last
         for i, (agent, speed) in enumerate(zip(agents, [g.speed for g in self.guards] + [player_speed])):
-            if settle(agent, before[i], speed, self.stuck_timeout) and i < last:
-                self.m.count_arrival(agent.history, agent.target)  # the player is not scored
-            node = node_near(agent.pos[0], agent.pos[1], agent.node)
+            # An agent that has reached its target stands on it, and stays on its node until
+            # it moves. Not always the node under its centre: on the partition a body stops
+            # on the target's stand point, which lies in a neighbouring triangle when the
+            # target's centroid is within a body radius of a wall (the slivers by a thin
+            # wall's end); read from the centre, the controller never saw it arrive, sent it
+            # to the same target again, and the body stood there (issue 24).
+            if settle(agent, before[i], speed, self.stuck_timeout):
+                if i < last:
+                    self.m.count_arrival(agent.history, agent.target)  # the player is not scored
+                node = agent.target
+            elif agent.pos == before[i]:
+                continue
+            else:
+                node = node_near(agent.pos[0], agent.pos[1], agent.node)
             if node != agent.node:
                 self._enter_node(agent, node, i)
         self.player_moved = self.player.pos != before[-1]
