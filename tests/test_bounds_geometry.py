@@ -304,21 +304,3 @@ def test_a_guard_sent_by_a_thin_wall_end_arrives_on_its_node(interval: float) ->
     assert tour.reached == stops, (
         f"guard 0 stands at {world.guards[0].pos} on node {world.guards[0].node}, "
         f"sent to {world.guards[0].target}")
-
-
-@pytest.mark.xfail(strict=True, reason="left as it is: fixing it changes the paper preset's "
-                   "table (4 of 600 partition trials on dishonored, seeds 0-2)")
-def test_a_step_landing_on_a_corner_keeps_the_next_corner() -> None:
-    # Two funnel corners 0.33 apart round a thin wall's end (random level 1, Staleness, t =
-    # 9.55 s). A step that lands on the first one is short (0.002 here) and advance() reads
-    # it as a stall, so it pops the second corner too (within radius + 0.05): the body then
-    # heads straight for the third point and cuts 0.10 into the wall.
-    level = _level([[[0, 4.25], [9.5, 4.25], [9.5, 4.35], [0, 4.35]]], width=12, height=8)
-    graph = graph_for(level, "partition")
-    walk = Locomotion(build_space(level), graph, level, RADIUS, 0.05)
-    agent = walk.make_agent(graph.node_at(9.0, 3.5), 2.0)
-    corner, behind, beyond = (9.8, 4.0), (9.8, 4.33), (9.0, 5.0)
-    agent.place(corner)
-    agent.waypoints = deque([corner, behind, beyond])
-    walk.advance(agent, 0.002, 0.1)  # the landing step: 0.002 of the 0.1 the speed allows
-    assert list(agent.waypoints) == [behind, beyond]
