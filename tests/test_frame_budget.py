@@ -54,6 +54,14 @@ def test_too_slow_a_frame_still_gets_the_floor_and_more_when_behind() -> None:
     assert _fed([0.0] * 30).spare(0.0) == budget.cap  # never more than the cap
 
 
+def test_a_spike_on_a_quick_machine_gets_nothing_ahead() -> None:
+    quick = _fed([0.002] * 60)  # an AI tick's frame of 9 ms among frames of 2 ms
+    assert quick.spare(0.009) == 0.0 and quick.spare(0.009, behind=True) == 0.0
+    assert quick.spare(0.005) > 0  # late in the period but not past the target
+    slow = _fed([0.009] * 60)  # every frame takes 9 ms: the floor, not nothing
+    assert slow.spare(0.009) == slow.floor
+
+
 def test_the_budget_follows_the_machine_as_it_changes() -> None:
     budget = _fed([0.002] * 120, window=120)
     quick = budget.spare(budget.typical)
@@ -115,10 +123,12 @@ def test_work_ahead_tells_the_guards_nodes_once_and_grants_the_budget() -> None:
     assert world.guard_ai.expected == [(1, 2, 7, 7)]  # the down guard's nodes are not read
     assert world.guard_ai.budgets == [pytest.approx(work.budget.spare(0.003))] * 2
     world.guards[0].node = 2  # it arrived: told again
-    world.guard_ai.left = True  # and the work ahead is not done: the floor doubles
-    work.after_frame(world, 0.020, idle=False)  # type: ignore[arg-type]
+    world.guard_ai.left = True  # and the work ahead is not done
     work.after_frame(world, 0.020, idle=False)  # type: ignore[arg-type]
     assert world.guard_ai.expected[-1] == (2, 2, 7, 7)
+    assert len(world.guard_ai.budgets) == 2  # a spike: told the nodes, no work ahead
+    for _ in range(60):  # the machine slows down for good: the floor, doubled when behind
+        work.after_frame(world, 0.020, idle=False)  # type: ignore[arg-type]
     assert world.guard_ai.budgets[-1] == 2 * work.budget.floor
     world.guard_ai = _GuardAI()  # a restart: the new guard AI is told the same nodes
     work.after_frame(world, 0.003, idle=True)  # type: ignore[arg-type]

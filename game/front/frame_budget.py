@@ -14,7 +14,9 @@ drawing, flip: everything but that extra work) and answers from what it saw:
 * :meth:`spare` — the work-ahead of the frame now — is the target minus what the frame
   took so far and the margin, never less than ``floor`` (so work ahead still makes
   progress on a machine too slow for the target, in small slices; twice that while work
-  ahead is left over from the last frame) nor more than ``cap``;
+  ahead is left over from the last frame) nor more than ``cap``; but nothing in a *spike*,
+  a frame past the target on a machine whose typical frame has time to spare (an AI tick:
+  the quick frames around it do the work, and the spike does not grow by the floor);
 * :meth:`stripes` — how many frames a piece of work of a measured cost is spread over —
   is that cost over the spare a *typical* frame has (the median of recent fixed costs).
 
@@ -28,6 +30,8 @@ with made-up costs.
 4.33
 >>> budget.stripes(0.010)             # 10 ms of composing: 3 frames of 4.33 ms
 3
+>>> budget.spare(0.009)               # a 9-ms spike (an AI tick): nothing ahead in it
+0.0
 """
 
 from __future__ import annotations
@@ -110,6 +114,8 @@ class FrameBudget:
         ``behind``: the last frame's work ahead was not done, so the floor is doubled
         (the work spreads over more of the frames before it is needed, not into one)."""
         left = self.target - max(0.0, elapsed) - self.margin
+        if left < 0 and self.typical + self.margin < self.target:
+            return 0.0  # a spike on a machine with time to spare: nothing ahead in it
         return min(self.cap, max(self.floor * (2.0 if behind else 1.0), left))
 
     def stripes(self, cost: float) -> int:

@@ -47,4 +47,6 @@ class WorkAhead:
         if (id(world.guard_ai), nodes) != self._expected:  # a restart has a new guard AI
             self._expected = (id(world.guard_ai), nodes)
             world.guard_ai.expect(nodes)
-        self.behind = bool(world.guard_ai.prepare(self.budget.spare(took, self.behind)))
+        spare = self.budget.spare(took, self.behind)
+        if spare > 0:  # none in a spike: not even the one ring a search makes per call
+            self.behind = bool(world.guard_ai.prepare(spare))
