@@ -439,7 +439,9 @@ def build_graph(level: Level, abstraction: str,
     """Build the node graph of ``level`` in ``abstraction`` ("grid" or "partition").
 
     On the grid only cells a body of ``radius`` can reach are nodes, joined where the
-    move is clear for it (:mod:`navmesh.clearance`); radius 0 is the bare cell grid.
+    move is clear for it (:mod:`navmesh.clearance`); radius 0 is the bare cell grid. The
+    partition's navmesh is bounded before it is triangulated
+    (:func:`navmesh.sizing.check_mesh_work`: a one-line LevelError past its limits).
     """
     if abstraction == "grid":
         if radius <= 0:
@@ -449,7 +451,9 @@ def build_graph(level: Level, abstraction: str,
                                    moves=(body.right_clear, body.down_clear))
     if abstraction == "partition":
         from .mesh import NavMesh
+        from .sizing import check_mesh_work
 
+        check_mesh_work(level)  # refuse before GEOS starts what would not end (issue 24)
         return NodeGraph.from_mesh(NavMesh.build(level.walkable))
     raise ValueError(f"unknown abstraction {abstraction!r} (choose grid or partition)")
 

@@ -53,12 +53,13 @@ def level_stats(level: Any) -> dict[str, Any]:
 def cmd_levels(args: argparse.Namespace) -> int:
     from navmesh.level import bundled_level_names, load_level
 
-    from navmesh.sizing import check_fits
+    from navmesh.sizing import check_fits, check_mesh_work
 
     names = args.level or bundled_level_names()
     levels = [load_level(name) for name in names]
     for name, level in zip(names, levels, strict=True):
         check_fits(level, str(name))  # refuse before building what cannot fit
+        check_mesh_work(level)  # or what would not end (the line sim gives on the partition)
     rows = [level_stats(level) for level in levels]
     if args.json:
         emit_json(rows)
@@ -104,12 +105,14 @@ def cmd_validate(args: argparse.Namespace) -> int:
 
 
 def _body_fits(name: str, level: Any) -> bool:
-    """Warn of passages narrower than an agent (``world.agent_radius``); False, after one
-    error line, when the walkable area is disconnected for its body (the check every
-    command shares: :func:`navmesh.clearance.check_body`)."""
+    """Warn of passages narrower than an agent (``world.agent_radius``) and of a navmesh
+    past its bound (:func:`navmesh.sizing.check_mesh_work`: only the grid runs the level);
+    False, after one error line, when the walkable area is disconnected for its body (the
+    check every command shares: :func:`navmesh.clearance.check_body`)."""
     from game.config import Config
     from navmesh.clearance import check_body
     from navmesh.errors import LevelError
+    from navmesh.sizing import check_mesh_work
 
     radius = float(Config.defaults()["world.agent_radius"])
     src = Path(name).name if Path(name).suffix else name
@@ -120,6 +123,11 @@ def _body_fits(name: str, level: Any) -> bool:
         return False
     for x, y in report.narrow:
         print(f"{src}: warning: passage narrower than {2 * radius:g} units near ({x:.1f}, {y:.1f})",
+              file=sys.stderr)
+    try:  # the partition abstraction's bound: a level only the grid runs is still valid
+        check_mesh_work(level, src)
+    except LevelError as error:
+        print(f"{src}: warning: the partition abstraction refuses this level: {error.problem}",
               file=sys.stderr)
     return True
 
