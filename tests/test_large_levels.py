@@ -185,3 +185,35 @@ def test_levels_below_the_navmesh_bound_still_get_their_mesh(tmp_path: Path) -> 
     sizing.check_mesh_work(level)
     stats = level_stats(level)
     assert stats["triangles"] > 2 * 49 * 49 and stats["walkable"] == 100 * 100 - 49 * 49
+
+
+def test_the_levels_table_keeps_wide_values_apart(tmp_path: Path, capsys: pytest.CaptureFixture[str]
+                                                   ) -> None:
+    """Areas of 10^4 and more and 7-digit counts ran together (``0.067829690.0348``): every
+    column is as wide as its widest value, with space between."""
+    from headless.cli import main
+    from headless.commands.levels import levels_table
+
+    rows = [{"name": "round", "triangles": 1234567, "min_area": 0.0678, "max_area": 29690.0348,
+             "avg_area": 123456.7891, "rows": 1000, "cols": 1000, "walkable": 1000000,
+             "blocked": 0},
+            {"name": "a-much-longer-name", "triangles": 5, "min_area": 0.5, "max_area": 1.0,
+             "avg_area": 0.75, "rows": 3, "cols": 4, "walkable": 9, "blocked": 3}]
+    lines = levels_table(rows)
+    assert lines[1].split() == ["round", "1234567", "0.0678", "29690.0348", "123456.7891",
+                                "1000", "1000", "1000000", "(100%)", "0", "(0%)"]
+    assert lines[2].split() == ["a-much-longer-name", "5", "0.5000", "1.0000", "0.7500", "3", "4",
+                                "9", "(75%)", "3", "(25%)"]
+    assert len({len(line) for line in lines}) == 1  # right-aligned columns end together
+    for column in ("tris", "min area", "max area", "avg area", "rows", "cols", "walkable"):
+        end = lines[0].index(column) + len(column)
+        assert all(line[end] == " " for line in lines), column  # a space after every column
+    # through the command: a 1000 × 1000 open grid of 10-unit cells (areas of 5 × 10^7)
+    path = tmp_path / "open.json"
+    path.write_text(json.dumps({"format": "stealth-level/1", "name": "open", "cell_size": 10.0,
+                                "grid": ["." * 1000] * 1000, "guards": [[5, 5]]}))
+    assert main(["levels", str(path)]) == 0
+    header, row = capsys.readouterr().out.splitlines()
+    values = row.split()
+    assert values[0] == "open" and values[-4:] == ["1000000", "(100%)", "0", "(0%)"]
+    assert all(float(v) >= 10**4 for v in values[2:5]) and len(header) == len(row)
