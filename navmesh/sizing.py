@@ -3,9 +3,10 @@ before building anything.
 
 ``stealth validate`` and ``stealth levels`` call :func:`check_fits` first, so a level too
 big to run is refused in one line that says how big it is, never with a MemoryError.
-:func:`check_mesh_work` bounds the partition navmesh's triangulation the same way: every
-build of a level's partition graph (:func:`navmesh.graph.build_graph`, so ``levels``,
-``path``, ``sim``, ``run``, ``play``, ``replay``) checks it before triangulating.
+:func:`check_mesh_work` bounds the partition's geometry work the same way (its navmesh's
+triangulation and its trials' eroded path area): every build of a level's partition graph
+(:func:`navmesh.graph.build_graph`, so ``levels``, ``path``, ``sim``, ``run``, ``play``,
+``replay``) checks it before triangulating.
 """
 
 from __future__ import annotations
@@ -21,7 +22,8 @@ if TYPE_CHECKING:
 
     from .level import Level
 
-__all__ = ["BYTES_PER_NODE", "MAX_MESH_CORNERS", "MAX_MESH_HOLE_WORK", "available_bytes",
+__all__ = ["BYTES_PER_NODE", "MAX_MESH_CORNERS", "MAX_MESH_HOLE_WORK", "MAX_PATH_HOLE_WORK",
+           "available_bytes",
            "check_fits", "check_mesh_work", "dense_bytes", "estimate_bytes", "walkable_size"]
 
 #: Corners of the walkable polygon the partition navmesh triangulates at most: the polygon
@@ -33,6 +35,13 @@ MAX_MESH_CORNERS = 200_000
 #: so far: measured 6–8 ns × holes × corners (grids of pillars and of plus-shaped holes,
 #: the 1000×1000 building: 1.0 × 10^9, 6.7 s), so about 10 s at the limit.
 MAX_MESH_HOLE_WORK = 1_500_000_000
+#: holes × outline corners at most: a partition trial also erodes the walkable area by the
+#: body's radius (:attr:`navmesh.clearance.Clearance.path_area`), and GEOS's buffer then
+#: tests every hole against the outline it may lie in, corner by corner: measured
+#: 50–75 ns × holes × outline corners (a toothed outline of 1.7 × 10^5 corners above
+#: 7,396 pillars: minutes), so 10–15 s at the limit. A grid of pillars in a box or the
+#: 1000×1000 building (outline of 4 corners) is far below it.
+MAX_PATH_HOLE_WORK = 200_000_000
 
 
 def walkable_size(polygon: Polygon) -> tuple[int, int]:
@@ -96,9 +105,11 @@ def check_fits(level: Level, source: str) -> None:
 def check_mesh_work(level: Level, source: str | None = None) -> None:
     """Raise a one-line :class:`~navmesh.level.LevelError` if the level's partition navmesh
     would take too long to triangulate: more than :data:`MAX_MESH_CORNERS` corners, or more
-    than :data:`MAX_MESH_HOLE_WORK` holes × corners. ``source`` names the level (default:
-    its file name, as :func:`navmesh.clearance.check_body` does). The grid abstraction
-    builds no navmesh and has no such limit.
+    than :data:`MAX_MESH_HOLE_WORK` holes × corners; or its trials' eroded path area too
+    long to compute: more than :data:`MAX_PATH_HOLE_WORK` holes × outline corners.
+    ``source`` names the level (default: its file name, as
+    :func:`navmesh.clearance.check_body` does). The grid abstraction builds neither and has
+    no such limit.
     """
     from .errors import LevelError
 
@@ -115,3 +126,11 @@ def check_mesh_work(level: Level, source: str | None = None) -> None:
             f"{holes} holes x {corners} corners = {holes * corners:.3g} for the partition "
             f"navmesh, more than the limit of {MAX_MESH_HOLE_WORK:.3g} (its triangulation "
             f"time grows with holes x corners; the grid abstraction has no such limit)")
+    outline = int(shapely.get_num_coordinates(level.walkable.exterior)) - 1
+    if holes * outline > MAX_PATH_HOLE_WORK:
+        raise LevelError(
+            src, "walkable area",
+            f"{holes} holes x {outline} outline corners = {holes * outline:.3g} for the "
+            f"partition's path area (the walkable area eroded by a body), more than the limit "
+            f"of {MAX_PATH_HOLE_WORK:.3g} (its time grows with holes x outline corners; the "
+            f"grid abstraction has no such limit)")

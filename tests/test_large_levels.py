@@ -217,3 +217,27 @@ def test_the_levels_table_keeps_wide_values_apart(tmp_path: Path, capsys: pytest
     values = row.split()
     assert values[0] == "open" and values[-4:] == ["1000000", "(100%)", "0", "(0%)"]
     assert all(float(v) >= 10**4 for v in values[2:5]) and len(header) == len(row)
+
+
+def test_a_toothed_outline_around_pillars_is_refused_for_the_partitions_path_area(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str],
+) -> None:
+    """Within the navmesh's bounds (its mesh: 20 s) but a partition trial's eroded path area
+    took minutes in GEOS's buffer (every hole tested against a 1.7 × 10^5-corner outline)."""
+    from headless.cli import main
+
+    cols, top, k = 640, 530, 86
+    occupancy = np.ones((top + 2 * k + 6, cols), dtype=bool)
+    for y in range(1, top - 3, 4):  # walls from the left border, teeth on every other cell
+        occupancy[y, : cols - 2] = False
+        occupancy[y + 1, : cols - 2 : 2] = False
+    occupancy[top + 1 : top + 1 + 2 * k : 2, 1 : 1 + 2 * k : 2] = False  # k × k pillars
+    path = tmp_path / "toothed.json"
+    path.write_text(json.dumps({"format": "stealth-level/1", "name": "toothed", "guards": [[0.5, 0.5]],
+                                "grid": ["".join(".#"[not c] for c in row) for row in occupancy]}))
+    assert main(["sim", str(path), "--abstraction", "partition"]) == 2
+    line = _error_line(capsys)
+    holes, corners = k * k, 198284
+    assert holes * corners <= sizing.MAX_MESH_HOLE_WORK and corners <= sizing.MAX_MESH_CORNERS
+    assert line.startswith(f"stealth: error: toothed.json: walkable area: {holes} holes x ")
+    assert "outline corners" in line and f"limit of {sizing.MAX_PATH_HOLE_WORK:.3g}" in line
