@@ -26,6 +26,7 @@ from scipy.sparse.csgraph import connected_components
 
 from .clearance import DEFAULT_AGENT_RADIUS, clearance_for
 from .distances import (
+    DENSE_MAX_NODES,
     ROW_CACHE_BYTES,
     UNREACHABLE_HOPS,
     Distances,
@@ -40,10 +41,6 @@ if TYPE_CHECKING:
 
 Abstraction = Literal["grid", "partition"]
 ABSTRACTIONS: tuple[str, ...] = ("grid", "partition")
-
-#: Graphs with at most this many nodes keep dense all-pairs matrices (20 bytes × n²:
-#: 84 MB at the limit); larger ones search per source. Results are the same either way.
-DENSE_MAX_NODES = 2048
 
 __all__ = ["ABSTRACTIONS", "DENSE_MAX_NODES", "ROW_CACHE_BYTES", "UNREACHABLE_HOPS", "Neighbours",
            "NodeGraph", "RowCache", "SlicedSearch", "build_graph", "falloff_depth", "graph_for",

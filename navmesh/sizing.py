@@ -15,7 +15,7 @@ from typing import TYPE_CHECKING
 
 import shapely
 
-from .graph import DENSE_MAX_NODES, ROW_CACHE_BYTES
+from .distances import DENSE_MAX_NODES, ROW_CACHE_BYTES
 
 if TYPE_CHECKING:
     from shapely.geometry import Polygon
