@@ -413,6 +413,8 @@ def parse_preset(
         for abstraction in abstractions:
             try:
                 graph_for(level, abstraction)
+            except LevelError as error:  # e.g. a navmesh past its bound: the level's own line
+                raise _fail(src, "levels", str(error)) from None
             except Exception as error:
                 raise _fail(src, "abstractions", f"{abstraction}: cannot build the graph of "
                             f"level {level.name!r} ({type(error).__name__}: {error})") from None

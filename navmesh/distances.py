@@ -27,6 +27,12 @@ from scipy.sparse.csgraph import dijkstra, shortest_path
 #: Hop distance used for node pairs that are not connected (or beyond a search's max_hops).
 UNREACHABLE_HOPS = np.iinfo(np.int32).max // 4
 
+#: Graphs with at most this many nodes keep dense all-pairs matrices (20 bytes × n²:
+#: 84 MB at the limit); larger ones search per source. Results are the same either way.
+#: (Here, not in :mod:`navmesh.graph`, which uses and re-exports it, so that
+#: :mod:`navmesh.sizing` reads it without importing the graph that imports sizing.)
+DENSE_MAX_NODES = 2048
+
 #: Bytes of per-source distance rows a searched graph keeps (least recently used go first).
 ROW_CACHE_BYTES = 256 * 2**20
 

@@ -26,6 +26,7 @@ from scipy.sparse.csgraph import connected_components
 
 from .clearance import DEFAULT_AGENT_RADIUS, clearance_for
 from .distances import (
+    DENSE_MAX_NODES,
     ROW_CACHE_BYTES,
     UNREACHABLE_HOPS,
     Distances,
@@ -40,10 +41,6 @@ if TYPE_CHECKING:
 
 Abstraction = Literal["grid", "partition"]
 ABSTRACTIONS: tuple[str, ...] = ("grid", "partition")
-
-#: Graphs with at most this many nodes keep dense all-pairs matrices (20 bytes × n²:
-#: 84 MB at the limit); larger ones search per source. Results are the same either way.
-DENSE_MAX_NODES = 2048
 
 __all__ = ["ABSTRACTIONS", "DENSE_MAX_NODES", "ROW_CACHE_BYTES", "UNREACHABLE_HOPS", "Neighbours",
            "NodeGraph", "RowCache", "SlicedSearch", "build_graph", "falloff_depth", "graph_for",
@@ -439,7 +436,9 @@ def build_graph(level: Level, abstraction: str,
     """Build the node graph of ``level`` in ``abstraction`` ("grid" or "partition").
 
     On the grid only cells a body of ``radius`` can reach are nodes, joined where the
-    move is clear for it (:mod:`navmesh.clearance`); radius 0 is the bare cell grid.
+    move is clear for it (:mod:`navmesh.clearance`); radius 0 is the bare cell grid. The
+    partition's navmesh is bounded before it is triangulated
+    (:func:`navmesh.sizing.check_mesh_work`: a one-line LevelError past its limits).
     """
     if abstraction == "grid":
         if radius <= 0:
@@ -449,7 +448,9 @@ def build_graph(level: Level, abstraction: str,
                                    moves=(body.right_clear, body.down_clear))
     if abstraction == "partition":
         from .mesh import NavMesh
+        from .sizing import check_mesh_work
 
+        check_mesh_work(level)  # refuse before GEOS starts what would not end (issue 24)
         return NodeGraph.from_mesh(NavMesh.build(level.walkable))
     raise ValueError(f"unknown abstraction {abstraction!r} (choose grid or partition)")
 

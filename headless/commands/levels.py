@@ -11,7 +11,7 @@ import sys
 from pathlib import Path
 from typing import Any
 
-__all__ = ["cmd_levels", "cmd_path", "cmd_validate", "emit_json", "level_stats"]
+__all__ = ["cmd_levels", "cmd_path", "cmd_validate", "emit_json", "level_stats", "levels_table"]
 
 EXIT_USER_ERROR = 2
 
@@ -53,28 +53,53 @@ def level_stats(level: Any) -> dict[str, Any]:
 def cmd_levels(args: argparse.Namespace) -> int:
     from navmesh.level import bundled_level_names, load_level
 
-    from navmesh.sizing import check_fits
+    from navmesh.sizing import check_fits, check_mesh_work
 
     names = args.level or bundled_level_names()
     levels = [load_level(name) for name in names]
     for name, level in zip(names, levels, strict=True):
         check_fits(level, str(name))  # refuse before building what cannot fit
+        check_mesh_work(level)  # or what would not end (the line sim gives on the partition)
     rows = [level_stats(level) for level in levels]
     if args.json:
         emit_json(rows)
         return 0
-    header = f"{'level':<12}{'tris':>6}{'min area':>10}{'max area':>10}{'avg area':>10}" \
-             f"{'rows':>6}{'cols':>6}{'walkable':>10}{'blocked':>9}"
-    print(header)
-    for r in rows:
-        total = r["walkable"] + r["blocked"]
-        print(
-            f"{r['name']:<12}{r['triangles']:>6}{r['min_area']:>10.4f}{r['max_area']:>10.4f}"
-            f"{r['avg_area']:>10.4f}{r['rows']:>6}{r['cols']:>6}"
-            f"{r['walkable']:>5} ({100 * r['walkable'] / total:2.0f}%)"
-            f"{r['blocked']:>4} ({100 * r['blocked'] / total:2.0f}%)"
-        )
+    for line in levels_table(rows):
+        print(line)
     return 0
+
+
+#: ``stealth levels``' columns: heading, left-aligned, and the cell text of a row
+_COLUMNS: tuple[tuple[str, bool, Any], ...] = (
+    ("level", True, lambda r: str(r["name"])),
+    ("tris", False, lambda r: str(r["triangles"])),
+    ("min area", False, lambda r: f"{r['min_area']:.4f}"),
+    ("max area", False, lambda r: f"{r['max_area']:.4f}"),
+    ("avg area", False, lambda r: f"{r['avg_area']:.4f}"),
+    ("rows", False, lambda r: str(r["rows"])),
+    ("cols", False, lambda r: str(r["cols"])),
+    ("walkable", False, lambda r: _count(r["walkable"], r)),
+    ("blocked", False, lambda r: _count(r["blocked"], r)),
+)
+
+
+def _count(cells: int, row: dict[str, Any]) -> str:
+    return f"{cells} ({100 * cells / (row['walkable'] + row['blocked']):.0f}%)"
+
+
+def levels_table(rows: list[dict[str, Any]]) -> list[str]:
+    """The text table of :func:`level_stats` rows: each column as wide as its widest value
+    or heading, two spaces between columns (so large areas and counts never run together).
+    """
+    cells = [[text(r) for _, _, text in _COLUMNS] for r in rows]
+    widths = [max([len(head)] + [len(line[k]) for line in cells])
+              for k, (head, _, _) in enumerate(_COLUMNS)]
+    lines = []
+    for line in [[head for head, _, _ in _COLUMNS], *cells]:
+        parts = [value.ljust(width) if left else value.rjust(width)
+                 for value, width, (_, left, _) in zip(line, widths, _COLUMNS, strict=True)]
+        lines.append("  ".join(parts).rstrip())
+    return lines
 
 
 def cmd_validate(args: argparse.Namespace) -> int:
@@ -104,12 +129,14 @@ def cmd_validate(args: argparse.Namespace) -> int:
 
 
 def _body_fits(name: str, level: Any) -> bool:
-    """Warn of passages narrower than an agent (``world.agent_radius``); False, after one
-    error line, when the walkable area is disconnected for its body (the check every
-    command shares: :func:`navmesh.clearance.check_body`)."""
+    """Warn of passages narrower than an agent (``world.agent_radius``) and of a navmesh
+    past its bound (:func:`navmesh.sizing.check_mesh_work`: only the grid runs the level);
+    False, after one error line, when the walkable area is disconnected for its body (the
+    check every command shares: :func:`navmesh.clearance.check_body`)."""
     from game.config import Config
     from navmesh.clearance import check_body
     from navmesh.errors import LevelError
+    from navmesh.sizing import check_mesh_work
 
     radius = float(Config.defaults()["world.agent_radius"])
     src = Path(name).name if Path(name).suffix else name
@@ -120,6 +147,11 @@ def _body_fits(name: str, level: Any) -> bool:
         return False
     for x, y in report.narrow:
         print(f"{src}: warning: passage narrower than {2 * radius:g} units near ({x:.1f}, {y:.1f})",
+              file=sys.stderr)
+    try:  # the partition abstraction's bound: a level only the grid runs is still valid
+        check_mesh_work(level, src)
+    except LevelError as error:
+        print(f"{src}: warning: the partition abstraction refuses this level: {error.problem}",
               file=sys.stderr)
     return True
 
