@@ -57,8 +57,7 @@ def cmd_play(args: argparse.Namespace, on_session: SessionSink | None = None) ->
 
     for plugin in args.stimulus:  # before the level: a plugin may declare its zone kinds
         load_stimulus(plugin)  # a bad plugin fails here with its one-line message
-    if args.level is not None:
-        load_level(args.level)  # a bad level fails here with its one-line message
+    loaded = load_level(args.level) if args.level is not None else None  # a bad level: one line
     try:
         overlay = overlay_key(args.overlay)
     except ValueError as error:
@@ -67,7 +66,11 @@ def cmd_play(args: argparse.Namespace, on_session: SessionSink | None = None) ->
         raise FrontError(f"--frames: expected a positive number of frames, got {args.frames}")
     from game.config import Config
 
-    Config.load({"world.spawns": "level"}).with_overrides(args.set)  # bad --set: one line
+    config = Config.load({"world.spawns": "level"}).with_overrides(args.set)  # bad --set: one line
+    if loaded is not None:
+        from game.schema import check_level
+
+        check_level(config, loaded)  # the world's own check, before a window or a note opens
     open_display()
     level = args.level
     if level is None:
