@@ -17,7 +17,7 @@ so every decision counts as arrived at once.
 Level kinds (both 12 x 8 rooms, regenerated until a body of the agent radius reaches the
 whole walkable area):
 
-* ``random``: the rooms of tests/test_bounds_geometry.py — 2-4 thin walls 0.05-0.2 thick,
+* ``random``: :func:`navmesh.rooms.thin_wall_room` (the rooms of tests/test_bounds_geometry.py) — 2-4 thin walls 0.05-0.2 thick,
   1-2 diamonds touching the outline at a vertex (pinch points), 0-2 boxes;
 * ``wall``: one thin wall (0.05-0.2 thick) from an outline edge most of the way across,
   so routes between the two sides must turn around its free end.
@@ -43,58 +43,11 @@ from ai import make_guard_ai, make_player_policy
 from game.config import Config
 from game.trial import player_params
 from game.world import World
-from navmesh.errors import LevelError
-from navmesh.level import Level, parse_level
+from navmesh.level import Level
+from navmesh.rooms import HEIGHT as H, WIDTH as W, room_level, thin_wall_room
 
 RADIUS = 0.3
-W, H = 12.0, 8.0
 CREEP = 0.02
-
-
-def _finish(name: str, obstacles: list) -> Level | None:
-    """The level, or None when it does not parse or a body cannot reach all of it."""
-    room = shapely.box(0, 0, W, H).difference(
-        shapely.union_all([shapely.Polygon(o) for o in obstacles]))
-    guard = [0.5, 0.5] if shapely.intersects_xy(room, 0.5, 0.5) else [W - 0.5, H - 0.5]
-    try:
-        level = parse_level({"format": "stealth-level/1", "name": name,
-                             "outline": [[0, 0], [W, 0], [W, H], [0, H]],
-                             "obstacles": obstacles, "guards": [guard]})
-    except LevelError:
-        return None
-    body = level.walkable.buffer(-RADIUS, join_style="mitre")
-    if len([g for g in shapely.get_parts(body) if g.area > 1e-4]) != 1:
-        return None
-    return level
-
-
-def random_level(index: int) -> Level:
-    """tests/test_bounds_geometry.py's generator (same draws for the same seed)."""
-    rng = np.random.default_rng(index)
-    while True:
-        obstacles = []
-        for _ in range(rng.integers(2, 5)):
-            x, y = rng.uniform(1, 11), rng.uniform(1, 7)
-            t, n = rng.uniform(0.05, 0.2), rng.uniform(1.5, 4)
-            if rng.random() < 0.5:
-                obstacles.append([[x, y], [x + t, y], [x + t, y + n], [x, y + n]])
-            else:
-                obstacles.append([[x, y], [x + n, y], [x + n, y + t], [x, y + t]])
-        for _ in range(rng.integers(1, 3)):
-            x, h, w = rng.uniform(2, 10), rng.uniform(1, 2.5), rng.uniform(0.3, 0.8)
-            top = bool(rng.random() < 0.5)
-            y0, s = (0.0, 1) if top else (8.0, -1)
-            obstacles.append([[x, y0], [x + w, y0 + s * h], [x, y0 + 2 * s * h],
-                              [x - w, y0 + s * h]])
-        for _ in range(rng.integers(0, 3)):
-            x, y, a = rng.uniform(1, 10), rng.uniform(1, 6), rng.uniform(0.5, 1.5)
-            obstacles.append([[x, y], [x + a, y], [x + a, y + a], [x, y + a]])
-            if rng.random() < 0.5:
-                obstacles.append([[x + a, y + a], [x + 2 * a, y + a], [x + 2 * a, y + 2 * a],
-                                  [x + a, y + 2 * a]])
-        level = _finish(f"random{index}", obstacles)
-        if level is not None:
-            return level
 
 
 def wall_level(index: int) -> Level:
@@ -112,12 +65,12 @@ def wall_level(index: int) -> Level:
             wall = [[at, lo], [at + t, lo], [at + t, hi], [at, hi]]
         else:
             wall = [[lo, at], [hi, at], [hi, at + t], [lo, at + t]]
-        level = _finish(f"wall{index}", [wall])
+        level = room_level(f"wall{index}", [wall], RADIUS)
         if level is not None:
             return level
 
 
-KINDS = {"random": random_level, "wall": wall_level}
+KINDS = {"random": thin_wall_room, "wall": wall_level}
 
 
 @dataclass(frozen=True)
