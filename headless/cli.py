@@ -68,23 +68,23 @@ _emit_json = emit_json
 
 
 # ---------------------------------------------------------------------- sim
-def _overrides(items: Sequence[str], level: Any, base: Mapping[str, Any] | None = None
-               ) -> tuple[tuple[str, Any], ...]:
-    """The ``--config`` file's settings (``base``) overridden by the ``--set`` pairs, every
-    key and value checked now, also against the level (one-line ConfigError before any
-    file is written)."""
-    from game.config import Config, parse_overrides
-    from game.schema import check_level
+def _settings(items: Sequence[str], base: Mapping[str, Any] | None = None
+              ) -> tuple[tuple[str, Any], ...]:
+    """The ``--config`` file's settings (``base``) overridden by the ``--set`` pairs, as the
+    trial's identity keeps them (the ``--set`` values as typed; checked by ``Config.load``)."""
+    from game.config import parse_overrides
 
-    settings = {**(base or {}), **dict(parse_overrides(items))}
-    check_level(Config.load(settings), level)
-    return tuple(settings.items())
+    return tuple({**(base or {}), **dict(parse_overrides(items))}.items())
 
 
 def cmd_sim(args: argparse.Namespace) -> int:
+    """``stealth sim``: the level and the config are loaded and checked once, here, and the
+    trial runs on them — its world is built (checking the config against the level) before
+    a ``--trace`` file is opened, so a mistake leaves no file behind."""
     from ai.stimuli import load_stimulus
+    from game.config import Config
     from game.config_file import read_config_file
-    from game.trial import TrialSpec, run_trial, sim_document
+    from game.trial import TrialSpec, make_world, run_trial, sim_document
     from navmesh.level import load_level
 
     if args.from_dir is not None or args.trial is not None:
@@ -103,10 +103,11 @@ def cmd_sim(args: argparse.Namespace) -> int:
         player=args.player,
         scenario=args.scenario,
         seed=args.seed,
-        overrides=_overrides(args.set, level,
-                             read_config_file(args.config) if args.config else {}),
+        overrides=_settings(args.set, read_config_file(args.config) if args.config else {}),
         stimuli=tuple(args.stimulus),
     )
+    config = Config.load(spec.settings)  # every key and value checked: one-line ConfigError
+    world = make_world(spec, config, level=level)  # checks the config against the level
     if args.trace:
         from navmesh.level import resolve_level_path
 
@@ -116,13 +117,13 @@ def cmd_sim(args: argparse.Namespace) -> int:
                                                      *plugin_files(args.stimulus)])
         try:
             with handle:
-                row = run_trial(spec, trace=handle, explain=args.explain)
+                row = run_trial(spec, trace=handle, explain=args.explain, world=world)
         except OSError as error:  # the disk filled up, the device refused: name the file
             raise OSError(error.errno, error.strerror, args.trace) from error
     elif args.explain:
-        row = run_trial(spec, trace=sys.stderr, explain=True)
+        row = run_trial(spec, trace=sys.stderr, explain=True, world=world)
     else:
-        row = run_trial(spec)
+        row = run_trial(spec, world=world)
     document = sim_document(row)
     if args.json:
         _emit_json(document)

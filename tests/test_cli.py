@@ -144,3 +144,28 @@ def test_play_help_lists_the_keys_without_importing_pygame() -> None:
 
     for keys, what in KEY_HELP:
         assert keys in result.stdout and what in result.stdout
+
+
+def test_sim_reads_and_checks_the_level_and_the_config_once(capsys: pytest.CaptureFixture) -> None:
+    """``stealth sim`` parses the level, loads the config and checks the agent's body against
+    the level once each, and hands them to the trial (cProfile counts the calls)."""
+    import cProfile
+    import pstats
+
+    from game.config import Config
+    from navmesh.clearance import check_body
+    from navmesh.level_format import parse_level
+
+    profile = cProfile.Profile()
+    profile.enable()
+    try:
+        code = main(["sim", "maze", "--guards", "pf", "--player", "maxmin",
+                     "--set", "world.duration=5"])
+    finally:
+        profile.disable()
+    assert code == 0 and "maze grid guards=pf" in capsys.readouterr().out
+    calls = {where: counts[1] for where, counts in pstats.Stats(profile).stats.items()}  # type: ignore[attr-defined]
+    for function in (parse_level, Config.load.__func__, check_body):
+        where = (function.__code__.co_filename, function.__code__.co_firstlineno,
+                 function.__code__.co_name)
+        assert calls.get(where) == 1, (function.__qualname__, calls.get(where))
