@@ -270,7 +270,7 @@ def build_parser() -> argparse.ArgumentParser:
         prog="stealth", description="Stealthfield: guards driven by composite potential fields.",
         formatter_class=_Help,
     )
-    parser.add_argument("--version", action=_Version, help="print the version and exit")
+    parser.add_argument("--version", action=_Version, help="show program's version number and exit")
     parser.add_argument("--debug", action="store_true",
                         help="on an error, print the traceback before the one-line message")
     sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
