@@ -31,7 +31,7 @@ from typing import Any  # noqa: E402
 
 from .commands.failure import EXIT_USER_ERROR, GuardedParser, UsageError, guarded, os_error_line, wants_debug  # noqa: E402
 
-__all__ = ["EXIT_USER_ERROR", "UsageError", "build_parser", "main", "os_error_line"]
+__all__ = ["ANALYSES", "EXIT_USER_ERROR", "UsageError", "build_parser", "main", "os_error_line"]
 
 
 def _point(text: str) -> tuple[float, float]:
@@ -168,6 +168,23 @@ def _cmd_tune(args: argparse.Namespace) -> int:
     from .tune.study import cmd_tune
 
     return cmd_tune(args)
+
+
+#: ``stealth analyse NAME``: each analysis and its module, whose ``run`` takes the arguments
+#: of ``python -m headless.NAME`` (NAME with ``_`` for ``-``), which keeps working.
+ANALYSES: dict[str, str] = {
+    "beside-paper": "headless.analysis.beside_paper",
+    "held-out": "headless.analysis.held_out",
+    "robustness": "headless.analysis.robustness",
+    "paired": "headless.analysis.paired",
+}
+
+
+def _cmd_analyse(args: argparse.Namespace) -> int:
+    from importlib import import_module
+
+    analysis = import_module(ANALYSES[args.analysis])
+    return int(analysis.run(args.words, prog=f"stealth analyse {args.analysis}"))
 
 
 # ---------------------------------------------------------------------- parser
@@ -396,6 +413,14 @@ def build_parser() -> argparse.ArgumentParser:
     p = command("report", "tables, CSVs and figures of a results directory")
     p.add_argument("dir", help="results directory written by stealth run")
     p.set_defaults(func=_cmd_report)
+
+    p = command("analyse", "analyses of results directories and reports (docs/experiments.md)")
+    p.add_argument("analysis", choices=list(ANALYSES), metavar="NAME",
+                   help="the analysis: %(choices)s")
+    p.add_argument("words", nargs=argparse.REMAINDER, metavar="...",
+                   help="its arguments, as for python -m headless.NAME (see stealth analyse "
+                        "NAME --help)")
+    p.set_defaults(func=_cmd_analyse)
 
     p = command("play", "play a level interactively", _PlayHelp, epilog=_KEYS)
     p.add_argument("level", nargs="?", default=None,

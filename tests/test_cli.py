@@ -118,7 +118,8 @@ def test_version_and_presets(capsys: pytest.CaptureFixture) -> None:
 
 
 @pytest.mark.parametrize("command", ["levels", "validate", "path", "sim", "mechanics",
-                                     "presets", "run", "report", "play", "replay", "tune"])
+                                     "presets", "run", "report", "play", "replay", "tune",
+                                     "analyse"])
 def test_every_option_is_documented_with_its_default(command: str) -> None:
     from headless.cli import build_parser
 
