@@ -25,7 +25,7 @@ if __name__ == "__main__" or os.path.basename(sys.argv[0]) == "stealth":  # not 
     signal.signal(signal.SIGINT, _quiet_interrupt)
 
 import argparse  # noqa: E402 - after the start-up handler above
-from collections.abc import Callable, Iterable, Iterator, Mapping, Sequence  # noqa: E402
+from collections.abc import Callable, Iterable, Iterator, Sequence  # noqa: E402
 from pathlib import Path  # noqa: E402
 from typing import Any  # noqa: E402
 

@@ -166,7 +166,7 @@ def test_sim_reads_and_checks_the_level_and_the_config_once(capsys: pytest.Captu
         profile.disable()
     assert code == 0 and "maze grid guards=pf" in capsys.readouterr().out
     calls = {where: counts[1] for where, counts in pstats.Stats(profile).stats.items()}  # type: ignore[attr-defined]
-    for function in (parse_level, Config.load.__func__, check_body):
+    for function in (parse_level, Config.load, check_body):
         where = (function.__code__.co_filename, function.__code__.co_firstlineno,
                  function.__code__.co_name)
         assert calls.get(where) == 1, (function.__qualname__, calls.get(where))
