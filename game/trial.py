@@ -150,16 +150,21 @@ def player_params(config: Config, scenario: str) -> dict[str, Any]:
 
 
 def run_trial(
-    spec: TrialSpec, trace: IO[str] | None = None, explain: bool = False
+    spec: TrialSpec, trace: IO[str] | None = None, explain: bool = False, *,
+    world: World | None = None,
 ) -> dict[str, Any]:
     """Run one trial to its end and return its row: identity, config hash, metrics, heatmaps.
 
     With ``trace`` every AI tick (and t = 0) is written as one JSON line; with ``explain``
-    those lines also carry the first guard's last decision explained (PF only).
+    those lines also carry the first guard's last decision explained (PF only). ``world``
+    is the trial's world already built by :func:`make_world` from ``spec`` (``stealth sim``
+    builds it from the level and config it loaded and checked, before it opens a trace);
+    else it is built here.
     """
-    config = Config.load(spec.settings)
     started = time.perf_counter()
-    world = make_world(spec, config)
+    if world is None:
+        world = make_world(spec, Config.load(spec.settings))
+    config = world.config
     writer = attach_trace(world, trace, explain=explain) if trace is not None else None
     metrics = world.run()
     if writer is not None:

@@ -24,13 +24,13 @@ from .config import Config
 from .guard_sight import GuardSight, ViewCover
 from .health import Health
 from .metrics import Counters, world_metrics
+from .scenarios import SCENARIOS
 from .schema import check_level
 from .senses import RANGE_EPS, Senses
 from .spawns import guard_spawn_nodes, level_start_node, respawn_node, start_node
 from .team import TeamRules
 from .zones import ZoneMap
 
-SCENARIOS = ("capture", "fixed")
 Generators = tuple[np.random.Generator, np.random.Generator, np.random.Generator]
 __all__ = ["Agent", "RANGE_EPS", "Refused", "SCENARIOS", "World", "decision_interval",
            "default_rngs"]

@@ -25,17 +25,13 @@ if __name__ == "__main__" or os.path.basename(sys.argv[0]) == "stealth":  # not 
     signal.signal(signal.SIGINT, _quiet_interrupt)
 
 import argparse  # noqa: E402 - after the start-up handler above
-from collections.abc import Mapping, Sequence  # noqa: E402
+from collections.abc import Callable, Iterable, Iterator, Sequence  # noqa: E402
 from pathlib import Path  # noqa: E402
 from typing import Any  # noqa: E402
 
-from .errors import UserError  # noqa: E402
-from .outputs import warning_lines  # noqa: E402
-from .commands.levels import cmd_levels, cmd_path, cmd_validate, emit_json, level_stats  # noqa: E402
-from .commands.failure import EXIT_USER_ERROR, GuardedParser, UsageError, guarded, os_error_line, wants_debug
+from .commands.failure import EXIT_USER_ERROR, GuardedParser, UsageError, guarded, os_error_line, wants_debug  # noqa: E402
 
-__all__ = ["EXIT_USER_ERROR", "UsageError", "build_parser", "cmd_levels", "cmd_path", "cmd_validate",
-           "level_stats", "main", "os_error_line"]
+__all__ = ["ANALYSES", "EXIT_USER_ERROR", "UsageError", "build_parser", "main", "os_error_line"]
 
 
 def _point(text: str) -> tuple[float, float]:
@@ -64,84 +60,15 @@ def _seed(text: str) -> int:
     return value
 
 
-_emit_json = emit_json
-
-
-# ---------------------------------------------------------------------- sim
-def _overrides(items: Sequence[str], level: Any, base: Mapping[str, Any] | None = None
-               ) -> tuple[tuple[str, Any], ...]:
-    """The ``--config`` file's settings (``base``) overridden by the ``--set`` pairs, every
-    key and value checked now, also against the level (one-line ConfigError before any
-    file is written)."""
-    from game.config import Config, parse_overrides
-    from game.schema import check_level
-
-    settings = {**(base or {}), **dict(parse_overrides(items))}
-    check_level(Config.load(settings), level)
-    return tuple(settings.items())
-
-
-def cmd_sim(args: argparse.Namespace) -> int:
-    from ai.stimuli import load_stimulus
-    from game.config_file import read_config_file
-    from game.trial import TrialSpec, run_trial, sim_document
-    from navmesh.level import load_level
-
-    if args.from_dir is not None or args.trial is not None:
-        from .reproduce import cmd_sim_from
-
-        return cmd_sim_from(args)
-    if args.level is None:
-        raise UsageError("sim: a LEVEL is required (or --from DIR --trial KEY)")
-    for plugin in args.stimulus:  # before the level: a plugin may declare its zone kinds
-        load_stimulus(plugin)  # a bad plugin fails here with its one-line message
-    level = load_level(args.level)  # a bad level fails here with its one-line message
-    spec = TrialSpec(
-        level=args.level,
-        abstraction=args.abstraction,
-        guards=args.guards,
-        player=args.player,
-        scenario=args.scenario,
-        seed=args.seed,
-        overrides=_overrides(args.set, level,
-                             read_config_file(args.config) if args.config else {}),
-        stimuli=tuple(args.stimulus),
-    )
-    if args.trace:
-        from navmesh.level import resolve_level_path
-
-        from .outputs.clobber import open_output, plugin_files
-
-        handle = open_output("--trace", args.trace, [resolve_level_path(args.level), args.config,
-                                                     *plugin_files(args.stimulus)])
-        try:
-            with handle:
-                row = run_trial(spec, trace=handle, explain=args.explain)
-        except OSError as error:  # the disk filled up, the device refused: name the file
-            raise OSError(error.errno, error.strerror, args.trace) from error
-    elif args.explain:
-        row = run_trial(spec, trace=sys.stderr, explain=True)
-    else:
-        row = run_trial(spec)
-    document = sim_document(row)
-    if args.json:
-        _emit_json(document)
-    else:
-        print(f"{document['level']} {document['abstraction']} guards={document['guards']} "
-              f"player={document['player']} scenario={document['scenario']} seed={document['seed']}")
-        for key, value in document["metrics"].items():
-            print(f"  {key:<22} {value}")
-    return 0
-
-
 # ---------------------------------------------------------------------- presets
 def cmd_presets(args: argparse.Namespace) -> int:
     """``stealth presets``: the bundled presets and their descriptions."""
+    from .commands.levels import emit_json
     from .presets import bundled_presets
 
     listed = bundled_presets()
     if args.json:
-        _emit_json([{"name": name, "description": text} for name, text in listed])
+        emit_json([{"name": name, "description": text} for name, text in listed])
         return 0
     width = max((len(name) for name, _ in listed), default=0)
     for name, text in listed:
@@ -150,6 +77,30 @@ def cmd_presets(args: argparse.Namespace) -> int:
 
 
 # ---------------------------------------------------------------------- lazy commands
+def _cmd_sim(args: argparse.Namespace) -> int:
+    from .commands.sim import cmd_sim
+
+    return cmd_sim(args)
+
+
+def _cmd_levels(args: argparse.Namespace) -> int:
+    from .commands.levels import cmd_levels
+
+    return cmd_levels(args)
+
+
+def _cmd_validate(args: argparse.Namespace) -> int:
+    from .commands.levels import cmd_validate
+
+    return cmd_validate(args)
+
+
+def _cmd_path(args: argparse.Namespace) -> int:
+    from .commands.levels import cmd_path
+
+    return cmd_path(args)
+
+
 def _cmd_run(args: argparse.Namespace) -> int:
     from .sweep import cmd_run
 
@@ -219,6 +170,23 @@ def _cmd_tune(args: argparse.Namespace) -> int:
     return cmd_tune(args)
 
 
+#: ``stealth analyse NAME``: each analysis and its module, whose ``run`` takes the arguments
+#: of ``python -m headless.NAME`` (NAME with ``_`` for ``-``), which keeps working.
+ANALYSES: dict[str, str] = {
+    "beside-paper": "headless.analysis.beside_paper",
+    "held-out": "headless.analysis.held_out",
+    "robustness": "headless.analysis.robustness",
+    "paired": "headless.analysis.paired",
+}
+
+
+def _cmd_analyse(args: argparse.Namespace) -> int:
+    from importlib import import_module
+
+    analysis = import_module(ANALYSES[args.analysis])
+    return int(analysis.run(args.words, prog=f"stealth analyse {args.analysis}"))
+
+
 # ---------------------------------------------------------------------- parser
 _Parser = GuardedParser
 
@@ -245,27 +213,88 @@ def _version() -> str:
         return "unknown (not installed)"
 
 
-def build_parser() -> argparse.ArgumentParser:
-    """The ``stealth`` parser; its choices come from the registries and name constants."""
-    from ai import GUARD_MODES, PLAYER_POLICIES
-    from navmesh.graph import ABSTRACTIONS
-    from game.front.keys import key_table
-    from game.scene import OVERLAYS
-    from game.world import SCENARIOS
+class _Version(argparse.Action):
+    """``--version``: the installed version, looked up only when asked (the lookup scans
+    the installed packages, which every other command would pay for)."""
 
-    modes, policies = list(GUARD_MODES), list(PLAYER_POLICIES)
+    def __init__(self, option_strings: Sequence[str], dest: str = argparse.SUPPRESS,
+                 default: str = argparse.SUPPRESS, help: str | None = None) -> None:
+        super().__init__(option_strings, dest, nargs=0, default=default, help=help)
+
+    def __call__(self, parser: argparse.ArgumentParser, namespace: argparse.Namespace,
+                 values: object, option_string: str | None = None) -> None:
+        print(f"stealth {_version()}")
+        parser.exit()
+
+
+class _Registered:
+    """The names of a registry (guard modes, player policies) as argparse ``choices``, read
+    when a value is checked or the help is printed: building the parser imports no
+    controller code, and a mode registered later is still accepted."""
+
+    def __init__(self, names: Callable[[], Iterable[str]]) -> None:
+        self._names = names
+
+    def __iter__(self) -> Iterator[str]:
+        return iter(list(self._names()))
+
+    def __contains__(self, name: object) -> bool:
+        return name in list(self._names())
+
+
+def _guard_modes() -> list[str]:
+    from ai import GUARD_MODES
+
+    return list(GUARD_MODES)
+
+
+def _player_policies() -> list[str]:
+    from ai import PLAYER_POLICIES
+
+    return list(PLAYER_POLICIES)
+
+
+#: ``stealth play``'s epilog, replaced by the key table when its help is printed.
+_KEYS = "keys:\n"
+
+
+class _PlayHelp(_Help):
+    """``stealth play --help``: the epilog lists the keys (:mod:`game.front.keys`, read only
+    when the help is printed)."""
+
+    def add_text(self, text: str | None) -> None:
+        if text == _KEYS:
+            from game.front.keys import key_table
+
+            text = _KEYS + key_table()
+        super().add_text(text)
+
+
+def build_parser() -> argparse.ArgumentParser:
+    """The ``stealth`` parser; its choices come from the registries and name constants.
+
+    Light: it imports the modules of names only (no numpy, pymunk, scipy or shapely); a
+    command imports what it needs when it runs, and the registries are read when a value
+    is checked (tests/test_cli.py counts the modules).
+    """
+    from game.overlays import OVERLAYS
+    from game.scenarios import SCENARIOS
+    from navmesh.abstractions import ABSTRACTIONS
+
+    modes, policies = _Registered(_guard_modes), _Registered(_player_policies)
     abstractions, scenarios = list(ABSTRACTIONS), list(SCENARIOS)
     parser = _Parser(
         prog="stealth", description="Stealthfield: guards driven by composite potential fields.",
         formatter_class=_Help,
     )
-    parser.add_argument("--version", action="version", version=f"stealth {_version()}")
+    parser.add_argument("--version", action=_Version, help="show program's version number and exit")
     parser.add_argument("--debug", action="store_true",
                         help="on an error, print the traceback before the one-line message")
     sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
 
-    def command(name: str, text: str, **kwargs: Any) -> argparse.ArgumentParser:
-        p = sub.add_parser(name, help=text, description=text, formatter_class=_Help, **kwargs)
+    def command(name: str, text: str, formatter: type[_Help] = _Help,
+                **kwargs: Any) -> argparse.ArgumentParser:
+        p = sub.add_parser(name, help=text, description=text, formatter_class=formatter, **kwargs)
         p.add_argument("--debug", action="store_true",
                        help="on an error, print the traceback before the one-line message")
         return p
@@ -294,12 +323,12 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("level", nargs="*", default=[],
                    help="level files or bundled names (default: every bundled level)")
     add_json(p)
-    p.set_defaults(func=cmd_levels)
+    p.set_defaults(func=_cmd_levels)
 
     p = command("validate", "check level files: exit 0, or one error line per bad file and exit 2")
     p.add_argument("level", nargs="+", help="level files or bundled names")
     add_stimulus(p, "load a plugin stimulus first, so its zone kinds are known")
-    p.set_defaults(func=cmd_validate)
+    p.set_defaults(func=_cmd_validate)
 
     p = command("path", "navmesh (funnel) path between two points")
     p.add_argument("level", help="level file or bundled name")
@@ -308,7 +337,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--to", type=_point, required=True, metavar="X,Y",
                    help="goal point in world units (required)")
     add_json(p)
-    p.set_defaults(func=cmd_path)
+    p.set_defaults(func=_cmd_path)
 
     p = command("sim", "run one trial and print its metrics")
     p.add_argument("level", nargs="?", default=None,
@@ -318,8 +347,10 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--trial", default=None, metavar="KEY",
                    help="key of the stored trial to re-run (the key column of trials.csv)")
     add_config(p)
-    p.add_argument("--guards", choices=modes, default="pf", help="guard mode")
-    p.add_argument("--player", choices=policies, default="maxmin", help="player policy")
+    p.add_argument("--guards", choices=modes, metavar="MODE", default="pf",
+                   help="guard mode: %(choices)s")
+    p.add_argument("--player", choices=policies, metavar="POLICY", default="maxmin",
+                   help="player policy: %(choices)s")
     p.add_argument("--abstraction", choices=abstractions, default="grid",
                    help="node graph the AI runs on")
     p.add_argument("--scenario", choices=scenarios, default="capture",
@@ -333,7 +364,7 @@ def build_parser() -> argparse.ArgumentParser:
                    help="add the first guard's decision explained to each trace line "
                         "(to stderr when no --trace)")
     add_stimulus(p, "add a stimulus")
-    p.set_defaults(func=cmd_sim)
+    p.set_defaults(func=_cmd_sim)
 
     p = command("mechanics", "measured effects of the stealth mechanics (docs/mechanics.md)")
     p.add_argument("--seeds", type=int, default=30, help="paired seeds per mechanic")
@@ -383,15 +414,24 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("dir", help="results directory written by stealth run")
     p.set_defaults(func=_cmd_report)
 
-    p = command("play", "play a level interactively",
-                epilog="keys:\n" + key_table())
+    p = command("analyse", "analyses of results directories and reports (docs/experiments.md)")
+    p.add_argument("analysis", choices=list(ANALYSES), metavar="NAME",
+                   help="the analysis: %(choices)s")
+    p.add_argument("words", nargs=argparse.REMAINDER, metavar="...",
+                   help="its arguments, as for python -m headless.NAME (see stealth analyse "
+                        "NAME --help)")
+    p.set_defaults(func=_cmd_analyse)
+
+    p = command("play", "play a level interactively", _PlayHelp, epilog=_KEYS)
     p.add_argument("level", nargs="?", default=None,
                    help="level file or bundled name (default: choose one in the window)")
-    p.add_argument("--guards", choices=modes, default="pf", help="guard mode")
+    p.add_argument("--guards", choices=modes, metavar="MODE", default="pf",
+                   help="guard mode: %(choices)s")
     p.add_argument("--abstraction", choices=abstractions, default="grid",
                    help="node graph the AI runs on")
-    p.add_argument("--autopilot", choices=policies, default=None,
-                   help="let a player policy play; a movement key takes over (default: you play)")
+    p.add_argument("--autopilot", choices=policies, metavar="POLICY", default=None,
+                   help="let a player policy play (%(choices)s); a movement key takes over "
+                        "(default: you play)")
     p.add_argument("--frames", type=int, default=None,
                    help="stop after N frames, one physics step each (default: play until Esc)")
     p.add_argument("--screenshot", default=None, metavar="FILE.png",
@@ -442,6 +482,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     imports of start-up, which happen inside it). ``--debug`` anywhere before ``--`` also
     prints the traceback.
     """
+    from .outputs import warning_lines
+
     words = list(sys.argv[1:] if argv is None else argv)
     warning_lines.install()
 

@@ -330,7 +330,7 @@ def parse_preset(
     from game.config import Config
     from game.errors import ConfigError
     from game.schema import SEED, check_level
-    from game.world import SCENARIOS
+    from game.scenarios import SCENARIOS
     from navmesh.errors import LevelError
     from navmesh.graph import ABSTRACTIONS, graph_for
     from navmesh.level import load_level

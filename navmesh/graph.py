@@ -18,12 +18,13 @@ import math
 from collections.abc import Iterator, Sequence
 from dataclasses import dataclass, field
 from functools import cached_property, lru_cache
-from typing import TYPE_CHECKING, Literal
+from typing import TYPE_CHECKING
 
 import numpy as np
 from scipy.sparse import csr_matrix
 from scipy.sparse.csgraph import connected_components
 
+from .abstractions import ABSTRACTIONS
 from .clearance import DEFAULT_AGENT_RADIUS, clearance_for
 from .distances import (
     DENSE_MAX_NODES,
@@ -39,8 +40,6 @@ if TYPE_CHECKING:
     from .level import Level
     from .mesh import NavMesh
 
-Abstraction = Literal["grid", "partition"]
-ABSTRACTIONS: tuple[str, ...] = ("grid", "partition")
 
 __all__ = ["ABSTRACTIONS", "DENSE_MAX_NODES", "ROW_CACHE_BYTES", "UNREACHABLE_HOPS", "Neighbours",
            "NodeGraph", "RowCache", "SlicedSearch", "build_graph", "falloff_depth", "graph_for",

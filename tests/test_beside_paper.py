@@ -3,7 +3,11 @@
 from __future__ import annotations
 
 import csv
+import subprocess
+import sys
 from pathlib import Path
+
+import pytest
 
 from headless.analysis.beside_paper import COLUMNS, main
 
@@ -45,3 +49,45 @@ def test_a_document_without_markers_is_refused(tmp_path: Path) -> None:
     doc.write_text("no markers\n", encoding="utf-8")
     assert main([str(_report(tmp_path / "paper", 0.5)), "--write", str(doc)]) == 2
     assert doc.read_text(encoding="utf-8") == "no markers\n"
+
+
+def _stealth(*args: str) -> subprocess.CompletedProcess[bytes]:
+    return subprocess.run([sys.executable, "-m", *args], capture_output=True, timeout=120)
+
+
+def test_analyse_beside_paper_writes_what_python_m_writes(tmp_path: Path) -> None:
+    """``stealth analyse beside-paper`` takes the arguments of ``python -m
+    headless.beside_paper`` and writes the same bytes, printed or into a marked file."""
+    ours = str(_report(tmp_path / "paper", 0.314))
+    literal = str(_report(tmp_path / "literal", 0.25))
+    printed = [_stealth("headless.beside_paper", ours, "--literal", literal),
+               _stealth("headless.cli", "analyse", "beside-paper", ours, "--literal", literal)]
+    assert [p.returncode for p in printed] == [0, 0], [p.stderr for p in printed]
+    assert printed[0].stdout == printed[1].stdout and b"0.31 (0.80)" in printed[0].stdout
+    written = []
+    for name, command in (("m", ["headless.beside_paper"]),
+                          ("cli", ["headless.cli", "analyse", "beside-paper"])):
+        doc = tmp_path / f"results-{name}.md"
+        doc.write_text("before\n<!-- beside-paper -->\nold\n<!-- /beside-paper -->\nafter\n",
+                       encoding="utf-8")
+        done = _stealth(*command, ours, "--write", str(doc))
+        assert done.returncode == 0 and done.stdout == b"", done.stderr
+        written.append(doc.read_bytes())
+    assert written[0] == written[1] and b"old" not in written[0]
+
+
+@pytest.mark.parametrize(("name", "module", "args"), [
+    ("beside-paper", "beside_paper", ["no-such-report"]),
+    ("held-out", "held_out", ["no-such-store", "--seeds-from", "-1"]),
+    ("robustness", "robustness", ["no-such-store"]),
+    ("paired", "paired", ["no-such-arm", "no-such-control"]),
+    ("paired", "paired", ["--no-such-option"]),
+])
+def test_analyse_errors_are_the_same_one_line(tmp_path: Path, name: str, module: str,
+                                              args: list[str]) -> None:
+    via_m = _stealth(f"headless.{module}", *args)
+    via_cli = _stealth("headless.cli", "analyse", name, *args)
+    assert via_m.returncode == via_cli.returncode == 2
+    assert via_m.stderr == via_cli.stderr and via_cli.stdout == b""
+    lines = via_cli.stderr.decode().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("stealth: error: "), lines

@@ -118,7 +118,8 @@ def test_version_and_presets(capsys: pytest.CaptureFixture) -> None:
 
 
 @pytest.mark.parametrize("command", ["levels", "validate", "path", "sim", "mechanics",
-                                     "presets", "run", "report", "play", "replay", "tune"])
+                                     "presets", "run", "report", "play", "replay", "tune",
+                                     "analyse"])
 def test_every_option_is_documented_with_its_default(command: str) -> None:
     from headless.cli import build_parser
 
@@ -144,3 +145,61 @@ def test_play_help_lists_the_keys_without_importing_pygame() -> None:
 
     for keys, what in KEY_HELP:
         assert keys in result.stdout and what in result.stdout
+
+
+def test_sim_reads_and_checks_the_level_and_the_config_once(capsys: pytest.CaptureFixture) -> None:
+    """``stealth sim`` parses the level, loads the config and checks the agent's body against
+    the level once each, and hands them to the trial (cProfile counts the calls)."""
+    import cProfile
+    import pstats
+
+    from game.config import Config
+    from navmesh.clearance import check_body
+    from navmesh.level_format import parse_level
+
+    profile = cProfile.Profile()
+    profile.enable()
+    try:
+        code = main(["sim", "maze", "--guards", "pf", "--player", "maxmin",
+                     "--set", "world.duration=5"])
+    finally:
+        profile.disable()
+    assert code == 0 and "maze grid guards=pf" in capsys.readouterr().out
+    calls = {where: counts[1] for where, counts in pstats.Stats(profile).stats.items()}  # type: ignore[attr-defined]
+    for function in (parse_level, Config.load, check_body):
+        where = (function.__code__.co_filename, function.__code__.co_firstlineno,
+                 function.__code__.co_name)
+        assert calls.get(where) == 1, (function.__qualname__, calls.get(where))
+
+
+def test_the_parser_is_light() -> None:
+    """Building the parser (and printing ``stealth --help``) imports the modules of names only:
+    no pymunk, scipy or shapely, at most 12 modules of the project (a fresh interpreter)."""
+    code = ("import json, sys\n"
+            "from headless.cli import build_parser\n"
+            "build_parser().format_help()\n"
+            "print(json.dumps(sorted(sys.modules)))\n")
+    result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                            timeout=60)
+    assert result.returncode == 0, result.stderr
+    loaded = json.loads(result.stdout)
+    assert not {"pymunk", "scipy", "shapely"} & set(loaded)
+    project = [m for m in loaded if m.split(".")[0] in ("navmesh", "ai", "game", "headless")]
+    assert "headless.cli" in project and len(project) <= 12, project
+
+
+def test_the_lazy_choices_still_check_and_list_the_registered_names(
+        capsys: pytest.CaptureFixture) -> None:
+    from ai import GUARD_MODES, PLAYER_POLICIES
+    from headless.cli import build_parser
+
+    parser = build_parser()
+    args = parser.parse_args(["sim", "maze", "--guards", "staleness", "--player", "safetygraph"])
+    assert (args.guards, args.player) == ("staleness", "safetygraph")
+    assert main(["sim", "maze", "--player", "sniper"]) == 2
+    error = capsys.readouterr().err
+    assert "invalid choice: 'sniper'" in error and all(p in error for p in PLAYER_POLICIES)
+    with pytest.raises(SystemExit):
+        main(["sim", "--help"])
+    shown = " ".join(capsys.readouterr().out.split())
+    assert "guard mode: " + ", ".join(GUARD_MODES) in shown

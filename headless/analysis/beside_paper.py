@@ -21,7 +21,7 @@ from ..outputs.clobber import refuse_inputs_all
 from .markers import replace_marked
 from .paper import paper_table3
 
-__all__ = ["COLUMNS", "beside_paper", "main"]
+__all__ = ["COLUMNS", "beside_paper", "main", "run"]
 
 #: (Table 3 column, the paper table's metric) in the paper's order
 COLUMNS: tuple[tuple[str, str], ...] = (
@@ -81,12 +81,13 @@ def main(argv: Sequence[str] | None = None) -> int:
     """``python -m headless.beside_paper``: its exit code; every failure one ``stealth: error:`` line
     (:func:`headless.commands.failure.guarded`, as for ``stealth``)."""
     words = list(sys.argv[1:] if argv is None else argv)
-    return guarded(lambda: _main(words), wants_debug(words))
+    return guarded(lambda: run(words), wants_debug(words))
 
 
-def _main(argv: Sequence[str]) -> int:
-    parser = GuardedParser(prog="python -m headless.beside_paper",
-                                     description=__doc__.split("\n\n")[0])
+def run(argv: Sequence[str], prog: str = "python -m headless.beside_paper") -> int:
+    """The analysis of the command line ``argv``, unguarded: :func:`main` guards it, and so
+    does ``stealth analyse`` (``prog`` names the command in the help)."""
+    parser = GuardedParser(prog=prog, description=__doc__.split("\n\n")[0])
     parser.add_argument("dir", type=Path, help="a report of the paper preset")
     parser.add_argument("--literal", type=Path, default=None,
                         help="a report of the paper-pf-literal preset (its PF rows are added)")

@@ -33,7 +33,7 @@ from ..store import ResultStore
 from .tables import ABSTRACTION_NAMES, GUARD_NAMES, PLAYER_NAMES
 
 __all__ = ["Compared", "compare", "distance", "held_out_markdown", "held_out_trials", "main",
-           "plot_errors"]
+           "plot_errors", "run"]
 
 _BEGIN, _END = "<!-- calibrated -->", "<!-- /calibrated -->"
 
@@ -209,12 +209,13 @@ def main(argv: Sequence[str] | None = None) -> int:
     """``python -m headless.held_out``: its exit code; every failure one ``stealth: error:`` line
     (:func:`headless.commands.failure.guarded`, as for ``stealth``)."""
     words = list(sys.argv[1:] if argv is None else argv)
-    return guarded(lambda: _main(words), wants_debug(words))
+    return guarded(lambda: run(words), wants_debug(words))
 
 
-def _main(argv: Sequence[str]) -> int:
-    parser = GuardedParser(prog="python -m headless.held_out",
-                                     description=__doc__.split("\n\n")[0])
+def run(argv: Sequence[str], prog: str = "python -m headless.held_out") -> int:
+    """The analysis of the command line ``argv``, unguarded: :func:`main` guards it, and so
+    does ``stealth analyse`` (``prog`` names the command in the help)."""
+    parser = GuardedParser(prog=prog, description=__doc__.split("\n\n")[0])
     parser.add_argument("dir", type=Path, help="a results directory (results.sqlite)")
     parser.add_argument("--seeds-from", type=int, default=0, metavar="K",
                         help="only trials with seed >= K (the held-out seeds)")

@@ -22,7 +22,7 @@ from ..commands.failure import GuardedParser, guarded, wants_debug
 from .stats import bootstrap_ci
 from ..store import STORE_NAME, ResultStore
 
-__all__ = ["MEASURES", "paired_rows", "paired_table"]
+__all__ = ["MEASURES", "main", "paired_rows", "paired_table", "run"]
 
 #: (Table 3 name, scenario, metric, value of a trial without the event)
 MEASURES: tuple[tuple[str, str, str, float | None], ...] = (
@@ -102,12 +102,13 @@ def main(argv: Sequence[str] | None = None) -> int:
     """``python -m headless.paired``: its exit code; every failure one ``stealth: error:`` line
     (:func:`headless.commands.failure.guarded`, as for ``stealth``)."""
     words = list(sys.argv[1:] if argv is None else argv)
-    return guarded(lambda: _main(words), wants_debug(words))
+    return guarded(lambda: run(words), wants_debug(words))
 
 
-def _main(argv: Sequence[str]) -> int:
-    parser = GuardedParser(prog="python -m headless.paired",
-                                     description=(__doc__ or "").split("\n\n")[0])
+def run(argv: Sequence[str], prog: str = "python -m headless.paired") -> int:
+    """The analysis of the command line ``argv``, unguarded: :func:`main` guards it, and so
+    does ``stealth analyse`` (``prog`` names the command in the help)."""
+    parser = GuardedParser(prog=prog, description=(__doc__ or "").split("\n\n")[0])
     parser.add_argument("arm", type=Path, help="results directory of the arm")
     parser.add_argument("control", type=Path, help="results directory of the control")
     parser.add_argument("--guards", default=None, help="only trials of this guard mode")

@@ -40,7 +40,7 @@ from ..store import STORE_NAME, ResultStore
 from .tables import ABSTRACTION_NAMES, GUARD_NAMES, _Durations, label, metric_value, table_columns
 
 __all__ = ["CLAIMS", "Axes", "Claim", "Judgement", "Verdict", "axes_of", "draw", "judge",
-           "main", "markdown", "write_between_markers"]
+           "main", "markdown", "run", "write_between_markers"]
 
 START, END = "<!-- robustness -->", "<!-- /robustness -->"
 SECTION = "## How robust are the paper's claims?"
@@ -313,12 +313,13 @@ def main(argv: Sequence[str] | None = None) -> int:
     """``python -m headless.robustness``: its exit code; every failure one ``stealth: error:`` line
     (:func:`headless.commands.failure.guarded`, as for ``stealth``)."""
     words = list(sys.argv[1:] if argv is None else argv)
-    return guarded(lambda: _main(words), wants_debug(words))
+    return guarded(lambda: run(words), wants_debug(words))
 
 
-def _main(argv: Sequence[str]) -> int:
-    parser = GuardedParser(prog="python -m headless.robustness",
-                                     description=(__doc__ or "").split("\n\n")[0])
+def run(argv: Sequence[str], prog: str = "python -m headless.robustness") -> int:
+    """The analysis of the command line ``argv``, unguarded: :func:`main` guards it, and so
+    does ``stealth analyse`` (``prog`` names the command in the help)."""
+    parser = GuardedParser(prog=prog, description=(__doc__ or "").split("\n\n")[0])
     parser.add_argument("store", type=Path, help="results directory of a two-factor design")
     parser.add_argument("--write", type=Path, default=None,
                         help="Markdown file to put the tables into (between the markers)")

@@ -25,7 +25,7 @@ from game.config import Config
 from game.errors import ConfigError
 from game.metrics import Metric, registered_metrics
 from game.trial import TrialSpec, run_trial
-from game.world import SCENARIOS
+from game.scenarios import SCENARIOS
 from navmesh.level import load_level
 
 from ..errors import UserError
