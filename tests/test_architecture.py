@@ -161,6 +161,14 @@ def test_no_layering_violation_at_any_depth() -> None:
     assert layering_violations() == []
 
 
+def test_mesh_imports_nothing_of_query() -> None:
+    """Build apart from query (Recast / Detour): navmesh/mesh.py reaches nothing of
+    navmesh/query.py, type-only and function-level imports counted."""
+    found = imports(ROOT / "navmesh" / "mesh.py", type_checking=True)
+    assert [m for m in found if m == "navmesh.query" or m.startswith("navmesh.query.")] == []
+    assert "navmesh.mesh" in imports(ROOT / "navmesh" / "query.py", type_checking=True)
+
+
 def test_no_import_cycle_between_modules() -> None:
     assert import_cycles(_graph()) == []
 

@@ -159,8 +159,9 @@ def _body_fits(name: str, level: Any) -> bool:
 # ---------------------------------------------------------------------- path
 def cmd_path(args: argparse.Namespace) -> int:
     from navmesh.level import load_level
+    from navmesh.query import find_path
 
-    path = _navmesh(load_level(args.level)).find_path(args.from_, args.to)
+    path = find_path(_navmesh(load_level(args.level)), args.from_, args.to)
     points = [[float(x), float(y)] for x, y in path.points]
     if args.json:
         emit_json({"points": points, "length": float(path.length)})
