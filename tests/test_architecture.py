@@ -212,6 +212,26 @@ def test_graph_size_is_read_in_at_most_two_places_outside_navmesh() -> None:
     assert len(_places(_reads_dense)) <= 2, _places(_reads_dense)
 
 
+def _reads_dense_threshold(path: Path, node: ast.AST) -> bool:
+    return (isinstance(node, ast.Name) and node.id == "DENSE_MAX_NODES"
+            and isinstance(node.ctx, ast.Load)) or (
+        isinstance(node, ast.Attribute) and node.attr == "DENSE_MAX_NODES")
+
+
+def test_one_predicate_decides_dense_or_searched() -> None:
+    """The dense/sparse threshold is read in ``navmesh.distances.keeps_dense`` alone; the
+    graph and the memory estimate ask that function."""
+    places = _places(_reads_dense_threshold)
+    assert len(places) == 1 and places[0].startswith("navmesh/distances.py:"), places
+    tree = ast.parse((ROOT / "navmesh" / "distances.py").read_text(encoding="utf-8"))
+    (keeps,) = [n for n in tree.body if isinstance(n, ast.FunctionDef) and n.name == "keeps_dense"]
+    assert keeps.lineno <= int(places[0].split(":")[1]) <= (keeps.end_lineno or 0)
+    for name in ("graph.py", "sizing.py"):
+        calls = {n.func.id for n in ast.walk(ast.parse((ROOT / "navmesh" / name).read_text(
+            encoding="utf-8"))) if isinstance(n, ast.Call) and isinstance(n.func, ast.Name)}
+        assert "keeps_dense" in calls, name
+
+
 def test_one_place_constructs_a_world() -> None:
     assert len(_places(_constructs_world)) == 1, _places(_constructs_world)
 
