@@ -1,7 +1,7 @@
 """The simulated world: one trial in progress, advanced by :meth:`World.step` (decisions,
 motion in :mod:`game.agents`, damage in :mod:`game.health`, senses in :mod:`game.senses`, the
-AI tick); player actions in :mod:`game.actions`, metrics in :mod:`game.metrics`, traces in
-:mod:`game.trace`. Never imports pygame: the front end and the headless runner share it."""
+AI tick); player actions in :mod:`game.actions`, metrics in :mod:`game.metrics`; traces are
+written by :mod:`game.trace`, which reads the world (the world never imports it). Never imports pygame: the front end and the headless runner share it."""
 
 from __future__ import annotations
 
@@ -17,8 +17,8 @@ from ai.view import Event
 from navmesh.graph import NodeGraph, graph_for
 from navmesh.level import Level
 
-from . import trace
-from .actions import ActionParams, PlayerActions, Refused
+from .action_params import ActionParams
+from .actions import PlayerActions, Refused
 from .agents import Agent, Locomotion, build_space
 from .config import Config
 from .guard_sight import GuardSight, ViewCover
@@ -326,10 +326,6 @@ class World(PlayerActions):
     def metrics(self) -> dict[str, Any]:
         """Every registered metric (:mod:`game.metrics`) of the trial so far (SPEC §9)."""
         return world_metrics(self)
-
-    def trace_record(self) -> dict[str, Any]:
-        """One trace line (:func:`game.trace.trace_record`)."""
-        return trace.trace_record(self)
 
 
 def _settle_agents(world: World, agents: list[Agent], before: list[tuple[float, float]],
