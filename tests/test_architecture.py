@@ -247,6 +247,29 @@ def test_one_place_constructs_a_world() -> None:
     assert len(_places(_constructs_world)) == 1, _places(_constructs_world)
 
 
+def _doc_table(doc: str, heading: str) -> list[str]:
+    """The first column of the first Markdown table after ``heading`` in ``doc``, backticks
+    stripped (the header row left out)."""
+    lines = doc[doc.index(heading):].splitlines()[1:]
+    start = next(i for i, line in enumerate(lines) if line.startswith("|"))
+    rows = []
+    for line in lines[start + 2:]:
+        if not line.startswith("|"):
+            break
+        rows.append(line.split("|")[1].strip().strip("`"))
+    return rows
+
+
+def test_the_level_table_of_the_architecture_lists_every_field() -> None:
+    from dataclasses import fields
+
+    from navmesh.level_format import Level
+
+    doc = (ROOT / "docs" / "architecture.md").read_text(encoding="utf-8")
+    table = _doc_table(doc, "### `navmesh.level.Level`")
+    assert table == [f.name for f in fields(Level)]
+
+
 def test_every_sub_package_opens_with_a_one_line_docstring() -> None:
     bad = []
     for init in sorted(p for package in PACKAGES for p in (ROOT / package).rglob("__init__.py")):
@@ -269,6 +292,11 @@ def test_every_sub_package_opens_with_a_one_line_docstring() -> None:
 def test_the_checker_sees_relative_lazy_and_nested_imports(source: str,
                                                             expected: list[str]) -> None:
     assert imports(ROOT / "game" / "probe.py", source) == expected
+
+
+def test_the_table_reader_reads_the_first_column() -> None:
+    doc = "## T\n\ntext\n\n| field | type |\n|---|---|\n| `a` | int |\n| `b` | str |\n\nafter\n"
+    assert _doc_table(doc, "## T") == ["a", "b"]
 
 
 def test_the_cycle_finder_finds_a_lazy_cycle() -> None:

@@ -1,6 +1,7 @@
 """``stealth levels``, ``validate`` and ``path``: the commands about level files themselves.
 
-Split from :mod:`headless.cli` (which registers them) so no module passes 500 lines.
+Kept apart from :mod:`headless.cli`, which registers them: the parser names the commands,
+this module answers them.
 """
 
 from __future__ import annotations
