@@ -22,21 +22,30 @@ from __future__ import annotations
 
 import inspect
 from collections.abc import Callable
-from typing import TYPE_CHECKING, Any, TypeVar
+from typing import Any, Protocol, TypeVar
 
 import numpy as np
 
 from .errors import StimulusError
 
-if TYPE_CHECKING:
-    from .stimulus import Stimulus
-
-__all__ = ["call", "checked_layer", "checked_number", "describe", "is_done"]
+__all__ = ["Plugin", "call", "checked_layer", "checked_number", "describe", "is_done"]
 
 T = TypeVar("T")
 
 
-def describe(stimulus: Stimulus) -> str:
+class Plugin(Protocol):
+    """What the checked calls read of plugin code's object (a :class:`~ai.stimulus.Stimulus`
+    or whatever a plugin hands over): the name errors give it, and ``done``, whose value
+    :func:`is_done` checks rather than trusts."""
+
+    @property
+    def name(self) -> str: ...
+
+    @property
+    def done(self) -> object: ...
+
+
+def describe(stimulus: Plugin) -> str:
     """``stimulus 'NAME' (module.Class)``: how errors name a stimulus."""
     kind = type(stimulus)
     try:
@@ -46,7 +55,7 @@ def describe(stimulus: Stimulus) -> str:
     return f"stimulus {str(stimulus.name)!r} ({kind.__qualname__}{where})"
 
 
-def call(stimulus: Stimulus, method: Callable[..., T], *args: Any) -> T:
+def call(stimulus: Plugin, method: Callable[..., T], *args: Any) -> T:
     """``method(*args)`` (a bound method of ``stimulus``); an exception becomes a StimulusError."""
     try:
         return method(*args)
@@ -57,7 +66,7 @@ def call(stimulus: Stimulus, method: Callable[..., T], *args: Any) -> T:
         raise StimulusError(f"{describe(stimulus)}: {method.__name__}() raised {text}") from error
 
 
-def is_done(stimulus: Stimulus) -> bool:
+def is_done(stimulus: Plugin) -> bool:
     """``stimulus.done`` (an attribute or a property), checked: a property that raises, or
     a value that is not a bool (a ``done`` written as a plain method), is a StimulusError."""
     try:
@@ -74,7 +83,7 @@ def is_done(stimulus: Stimulus) -> bool:
                         f"{type(value).__name__}{hint}")
 
 
-def checked_layer(stimulus: Stimulus, values: Any, n: int) -> np.ndarray | None:
+def checked_layer(stimulus: Plugin, values: Any, n: int) -> np.ndarray | None:
     """``inject()``'s answer as a float array of shape ``(n,)`` with finite values, or None."""
     if values is None:
         return None
@@ -93,7 +102,7 @@ def checked_layer(stimulus: Stimulus, values: Any, n: int) -> np.ndarray | None:
     return layer
 
 
-def checked_number(stimulus: Stimulus, what: str, value: Any, low: float, high: float) -> float:
+def checked_number(stimulus: Plugin, what: str, value: Any, low: float, high: float) -> float:
     """A number a stimulus answers with (a weight floor, a sound's amplitude), in [low, high]."""
     ok = isinstance(value, (int, float, np.floating, np.integer)) and not isinstance(value, bool)
     number = float(value) if ok else float("nan")

@@ -31,7 +31,7 @@ class StimulusParams(_Params):
     """The ``[stimuli]`` section of the config: the paper's values (SPEC §5) are the defaults.
 
     The section's player-action keys (``throw_cooldown``, ``throw_radius``, ``decoy_reach``,
-    ``takedown_range``) are the world's (``game.actions.ActionParams``), not these.
+    ``takedown_range``) are the world's (``game.action_params.ActionParams``), not these.
     """
 
     #: footstep noise while sprinting (and a thrown decoy's landing): −A·α^d up to max_hops

@@ -5,7 +5,7 @@
 For every bundled level (plus a synthetic 28×39 level with 10 holes), on the default mesh
 and the same random point pairs:
 
-* ``exact``  — :meth:`NavMesh.find_path` (default): corridor of the true shortest path.
+* ``exact``  — :func:`navmesh.query.find_path` (default): corridor of the true shortest path.
 * ``astar``  — ``find_path(..., exact=False)``: A* with portal entry-point costs + funnel.
 * ``pynavmesh`` — the pure-Python ``pynavmesh`` package on the SAME triangles (passed
   clockwise in its XZ plane, which it needs) with its own A* + funnel.
@@ -29,6 +29,7 @@ from shapely import Polygon, box
 from shapely.affinity import rotate
 
 from navmesh.mesh import METHODS, NavMesh
+from navmesh.query import find_path
 from oracle import VisibilityGraph
 
 
@@ -133,7 +134,7 @@ def main() -> None:
     args = ap.parse_args()
 
     warm = NavMesh.build(box(0, 0, 4, 4).difference(box(1, 1, 3, 3)))
-    warm.find_path((0.5, 0.5), (3.5, 3.5))  # first tables build imports scipy: keep it out of the timings
+    find_path(warm, (0.5, 0.5), (3.5, 3.5))  # first tables build imports scipy: keep it out of the timings
     rows, speedups = [], []
     method_rows: dict[str, list] = {m: [] for m in METHODS}
     for name, poly in levels(args.levels):
@@ -146,7 +147,7 @@ def main() -> None:
         mesh = NavMesh.build(poly)
         build_ms = (time.perf_counter() - t0) * 1e3
         t0 = time.perf_counter()
-        mesh.find_path(pairs[0, 0], pairs[0, 1])  # builds the exact-path tables
+        find_path(mesh, pairs[0, 0], pairs[0, 1])  # builds the exact-path tables
         tables_ms = (time.perf_counter() - t0) * 1e3
         loc = [mesh.locate(float(x), float(y)) for x, y in pairs.reshape(-1, 2)]
         t0 = time.perf_counter()
@@ -154,8 +155,8 @@ def main() -> None:
             mesh.locate(x, y)
         locate_us = (time.perf_counter() - t0) / (2 * len(pairs)) * 1e6
         assert min(loc) >= 0
-        ex, ex_us = timed(lambda s, g, mesh=mesh: mesh.find_path(s, g).length, pairs)
-        sa, sa_us = timed(lambda s, g, mesh=mesh: mesh.find_path(s, g, exact=False).length, pairs)
+        ex, ex_us = timed(lambda s, g, mesh=mesh: find_path(mesh, s, g).length, pairs)
+        sa, sa_us = timed(lambda s, g, mesh=mesh: find_path(mesh, s, g, exact=False).length, pairs)
         row = [name, len(mesh), build_ms, tables_ms, locate_us, stats(ex / best), ex_us, stats(sa / best), sa_us]
         pyn = pynavmesh_search(mesh)
         if pyn is not None:
@@ -170,8 +171,8 @@ def main() -> None:
                 t0 = time.perf_counter()
                 m = NavMesh.build(poly, method=method)
                 bms = (time.perf_counter() - t0) * 1e3
-                ls, us = timed(lambda s, g, m=m: m.find_path(s, g, exact=False).length, pairs)
-                le, use = timed(lambda s, g, m=m: m.find_path(s, g).length, pairs)
+                ls, us = timed(lambda s, g, m=m: find_path(m, s, g, exact=False).length, pairs)
+                le, use = timed(lambda s, g, m=m: find_path(m, s, g).length, pairs)
                 method_rows[method].append((name, len(m), bms, ls / best, us, le / best, use))
 
     print(f"\n## Default mesh ({NavMesh.build.__kwdefaults__['method']}), {args.pairs} random pairs per level")

@@ -5,22 +5,19 @@ dispatch table behind :meth:`game.world.World.perform` (a scripted player's
 :class:`~ai.view.Action`) and the world's named methods (what the keys do in play). An
 action raises an event; the stimulus it makes enters the fields at the next AI tick.
 
-The tunables of these actions are the world's (:class:`ActionParams`), not the guard AI's;
-they keep their keys in the ``[stimuli]`` config section (``stimuli.throw_cooldown`` ...)
-so config files and config hashes did not change when they moved here (docs/world.md).
+The tunables of these actions are the world's, not the guard AI's; they are declared below
+the world, in :mod:`game.action_params`, so the config schema reads them without reaching
+the world (docs/world.md).
 """
 
 from __future__ import annotations
 
 import math
-from collections.abc import Callable, Mapping
-from dataclasses import dataclass, fields
+from collections.abc import Callable
 from typing import TYPE_CHECKING, Any, cast
 
 import numpy as np
 
-from ai.bounds import COUNT, NON_NEGATIVE, POSITIVE
-from ai.params import _Params
 from ai.view import PLAYER_ACTIONS, Action, Event
 from navmesh.level import Level
 
@@ -39,38 +36,6 @@ class Refused(str):
 
     def __bool__(self) -> bool:
         return False
-
-
-@dataclass(frozen=True)
-class ActionParams(_Params):
-    """Tunables of the player's actions; config keys ``stimuli.<name>`` (see the module)."""
-
-    #: thrown decoy: seconds between throws, landing within this Manhattan radius in cells
-    throw_cooldown: float = 10.0
-    throw_radius: int = 4
-    #: the player activates a level decoy within this distance (world units, line of sight)
-    decoy_reach: float = 1.5
-    #: take-down: guard centre within this distance of the player's, player outside its cone
-    takedown_range: float = 1.0
-
-    bounds = {
-        "throw_cooldown": NON_NEGATIVE,
-        "throw_radius": COUNT,
-        "decoy_reach": NON_NEGATIVE,
-        "takedown_range": POSITIVE,
-    }
-
-    @classmethod
-    def split(cls, section: Mapping[str, Any]) -> tuple[ActionParams, dict[str, Any]]:
-        """This object from its keys of a ``[stimuli]`` section, and the other keys.
-
-        >>> params, rest = ActionParams.split({"throw_radius": 2, "noise_decay": 0.5})
-        >>> params.throw_radius, rest
-        (2, {'noise_decay': 0.5})
-        """
-        own = {f.name for f in fields(cls)}
-        params = cls.from_mapping({k: v for k, v in section.items() if k in own})
-        return params, {k: v for k, v in section.items() if k not in own}
 
 
 Outcome = bool | Refused
@@ -305,4 +270,4 @@ class PlayerActions:
         nodes = [s.node for s in world.stimuli.markers()]
         return world.graph.positions[nodes].reshape(-1, 2)
 
-__all__ = ["ACTIONS", "PlayerActions", "ActionParams", "Refused", "landing_node", "node_containing", "perform"]
+__all__ = ["ACTIONS", "PlayerActions", "Refused", "landing_node", "node_containing", "perform"]

@@ -21,6 +21,7 @@ import pymunk
 from navmesh.clearance import clearance_for
 from navmesh.graph import NodeGraph
 from navmesh.level import Level
+from navmesh.query import find_path
 
 WALL_CATEGORY = 0b01
 AGENT_CATEGORY = 0b10
@@ -164,7 +165,7 @@ class Locomotion:
         if target == agent.node:
             agent.waypoints = deque([goal])
             return
-        points = self.graph.mesh.find_path(agent.pos, goal).points
+        points = find_path(self.graph.mesh, agent.pos, goal).points
         agent.waypoints = deque(self.clear_corners(points))
 
     def _grid_start(self, agent: Agent) -> list[tuple[float, float]]:

@@ -23,17 +23,18 @@ import math
 from collections import deque
 from collections.abc import Callable
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, Protocol
 
 import numpy as np
 
 if TYPE_CHECKING:
+    from navmesh.graph import NodeGraph
+
     from .large.distance_worker import DistanceWorker
     from .guard_sight import ViewCover
-    from .world import World
 
 __all__ = ["AGGREGATES", "BACKTRACK_RULES", "COVERAGE_RULES", "Counters", "DISTANCE_RULES",
-           "Metric", "RECENT_ENTRIES", "TableColumn", "register_metric", "registered_metrics",
+           "Measured", "Metric", "RECENT_ENTRIES", "TableColumn", "register_metric", "registered_metrics",
            "metric_names", "unregister_metric", "world_metrics"]
 
 #: how a metric's per-trial values become one Table 3 cell: ``mean`` of the values, or
@@ -219,18 +220,41 @@ class TableColumn:
         return self.title + (f" ({self.metric.unit})" if self.metric.unit_in_title else "")
 
 
+class Sections(Protocol):
+    """Config values read a section at a time (a :class:`game.config.Config` is one)."""
+
+    def section(self, name: str) -> dict[str, Any]: ...
+
+
+class Measured(Protocol):
+    """What a metric reads of a trial: the world's :class:`Counters` (``m``), its node graph
+    and its config (the ``[metrics]`` definitions). A :class:`game.world.World` is one; this
+    module never imports the world, which reads it.
+    """
+
+    @property
+    def m(self) -> Counters: ...
+
+    @property
+    def graph(self) -> NodeGraph: ...
+
+    @property
+    def config(self) -> Sections: ...
+
+
 @dataclass(frozen=True)
 class Metric:
     """One trial metric, declared once.
 
-    ``compute(world)`` reads the world's counters (``world.m``) at the end of a trial and
+    ``compute(world)`` reads the world's counters (``world.m``; :class:`Measured` says what a
+    metric may read) at the end of a trial and
     returns a JSON value (``None``: it did not happen). ``column``/``title`` name its Table 3
     column (``column=None``: stored and in ``trials.csv`` but not in Table 3). ``censor``: a
     missing value counts as the trial's full duration in Table 3 (times of events).
     """
 
     name: str
-    compute: Callable[[World], Any]
+    compute: Callable[[Measured], Any]
     kind: str = "float"                  # bool | int | float
     unit: str = ""                       # unit of the Table 3 value ("" = a count)
     scenarios: tuple[str, ...] = ("fixed",)
@@ -274,27 +298,27 @@ def _round(value: float | None) -> float | None:
     return None if value is None else round(value, 6)
 
 
-def _visited(w: World) -> float:
+def _visited(w: Measured) -> float:
     return float(w.m.covered.mean()) if w.graph.n else 0.0
 
 
 #: every definition of the keyed metrics (SPEC §11), by the value of its ``metrics.*`` key
-_COVERAGE: dict[str, Callable[[World], float | None]] = {
+_COVERAGE: dict[str, Callable[[Measured], float | None]] = {
     "visited": _visited,
     "seen": lambda w: w.m.seen_coverage(),
     "per_guard": lambda w: w.m.per_guard_coverage(),
 }
-_BACKTRACKS: dict[str, Callable[[World], int]] = {
+_BACKTRACKS: dict[str, Callable[[Measured], int]] = {
     "targets": lambda w: w.m.backtracks,
     "entries": lambda w: w.m.entry_backtracks,
 }
-_DISTANCE: dict[str, Callable[[World], float | None]] = {
+_DISTANCE: dict[str, Callable[[Measured], float | None]] = {
     "path": lambda w: w.m.mean_distance(),
     "euclidean": lambda w: w.m.mean_euclidean(),
 }
 
 
-def _keyed(table: dict[str, Callable[[World], Any]], key: str) -> Callable[[World], Any]:
+def _keyed(table: dict[str, Callable[[Measured], Any]], key: str) -> Callable[[Measured], Any]:
     """The metric as the world's ``metrics.<key>`` defines it (today's without the key)."""
     first = next(iter(table))
     return lambda w: table[w.config.section("metrics").get(key, first)](w)
@@ -382,6 +406,6 @@ def metric_names() -> tuple[str, ...]:
     return tuple(_REGISTRY)
 
 
-def world_metrics(world: World) -> dict[str, Any]:
+def world_metrics(world: Measured) -> dict[str, Any]:
     """Every registered metric of ``world`` as the SPEC §9 ``metrics`` object."""
     return {m.name: m.compute(world) for m in _REGISTRY.values()}

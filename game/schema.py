@@ -3,7 +3,7 @@
 A section that feeds a parameter dataclass takes that class's ``bounds``
 (:mod:`ai.bounds`): ``[pf]`` is :class:`~ai.params.PFParams`, ``[fsm]`` / ``[staleness]``
 the FSM classes, ``[player]`` :class:`~ai.params.PlayerParams`, ``[stimuli]``
-:class:`~ai.stimuli.StimulusParams` plus :class:`~game.actions.ActionParams`, ``[zones]``
+:class:`~ai.stimuli.StimulusParams` plus :class:`~game.action_params.ActionParams`, ``[zones]``
 :class:`~ai.stimuli.Zone` per zone kind. The world's and the scenarios' keys, which no
 dataclass holds, are declared here. :func:`game.config.check_value` checks a value against
 :func:`bound_of` its key; :func:`check_sections` builds the dataclasses (their cross-key
@@ -19,7 +19,7 @@ True
 from __future__ import annotations
 
 from collections.abc import Iterable, Mapping
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, Protocol
 
 from ai.bounds import COUNT, FLAG, NON_NEGATIVE, POSITIVE, Bound, OneOf, Range
 from ai.alert import AlertParams
@@ -31,15 +31,13 @@ from ai.stimuli import StimulusParams, Zone, zones_from_config
 from navmesh.clearance import check_body
 from navmesh.level import ZONE_KINDS
 
-from .actions import ActionParams
+from .action_params import ActionParams
 from .budget import check_trial_steps
 from .errors import ConfigError
 from .metrics import BACKTRACK_RULES, COVERAGE_RULES, DISTANCE_RULES
 
 if TYPE_CHECKING:
     from navmesh.level import Level
-
-    from .config import Config
 
 __all__ = [
     "RESPAWN_RULES", "SEED", "SPAWN_RULES", "bound_of", "check_level", "check_sections", "markdown_table",
@@ -180,7 +178,14 @@ def check_sections(values: Mapping[str, Any]) -> None:
     check_trial_steps(values)  # the work budget (game.budget)
 
 
-def check_level(config: Config, level: Level) -> None:
+class Settings(Protocol):
+    """Config values read by dotted key (a :class:`game.config.Config`, which is built on
+    this module: the schema never names it)."""
+
+    def __getitem__(self, key: str) -> Any: ...
+
+
+def check_level(config: Settings, level: Level) -> None:
     """What a level bounds: an agent's body must pass a one-cell corridor, so
     ``world.agent_radius`` must be below half the level's cell size (both abstractions:
     the level is drawn on that grid). Raises :class:`ConfigError`; a level whose walkable

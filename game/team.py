@@ -12,9 +12,9 @@ sees only its declared hooks.
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, Protocol
 
 from ai.alert import AlertParams, AlertPhases
 from ai.awareness import Awareness, AwarenessParams, suspicion_rule
@@ -26,7 +26,11 @@ from ai.stimuli import StimulusSet
 from .errors import ConfigError
 
 if TYPE_CHECKING:
-    from .world import World
+    import numpy as np
+
+    from ai.view import Event
+
+    from .agents import Agent
 
 #: config sections with an ``enabled`` switch, in the order they are wired
 SECTIONS = ("awareness", "alert", "radio", "roles")
@@ -41,6 +45,43 @@ def _params(config: Any, section: str, cls: type[_Params]) -> Any | None:
         return cls.from_mapping(values)
     except ValueError as error:
         raise ConfigError(f"[{section}]: {error}") from None
+
+
+class TeamWorld(Protocol):
+    """What the team rules read of the world they serve (a :class:`game.world.World` is
+    one; this module never imports the world, which owns the rules)."""
+
+    @property
+    def player(self) -> Agent: ...
+
+    @property
+    def guards(self) -> Sequence[Agent]: ...
+
+    @property
+    def zones(self) -> Mapping[str, np.ndarray]: ...
+
+    @property
+    def events(self) -> list[Event]: ...
+
+    @property
+    def t(self) -> float: ...
+
+    @property
+    def dt(self) -> float: ...
+
+    @property
+    def step_index(self) -> int: ...
+
+    @property
+    def player_moved(self) -> bool: ...
+
+    @property
+    def sprinting(self) -> bool: ...
+
+    @property
+    def guard_speed(self) -> float: ...
+
+    def view_reach(self) -> float: ...
 
 
 @dataclass
@@ -74,7 +115,7 @@ class TeamRules:
             stimuli.add(rules.roles)
         return rules
 
-    def detect(self, world: World, perceived: Sequence[int]) -> tuple[int, ...]:
+    def detect(self, world: TeamWorld, perceived: Sequence[int]) -> tuple[int, ...]:
         """The guards that detect the player now: ``perceived`` itself (the paper) or,
         with graded perception, those whose awareness crossed the threshold."""
         if self.awareness is None:
@@ -82,25 +123,25 @@ class TeamRules:
         px, py = world.player.pos
         node = world.player.node
         distances = [math.hypot(g.pos[0] - px, g.pos[1] - py) for g in world.guards]
-        reach = world.view_range * float(world.view_scale_at[node])
+        reach = world.view_reach()
         dark = bool(world.zones["dark"][node]) if "dark" in world.zones else False
         concealed = bool(world.zones["concealment"][node]) if "concealment" in world.zones else False
         gait = "still" if not world.player_moved else "sprint" if world.sprinting else "walk"
         dt = world.dt if world.step_index > 0 else 0.0
         return self.awareness.update(perceived, distances, reach, dark, concealed, gait, node, dt)
 
-    def before_tick(self, world: World) -> None:
+    def before_tick(self, world: TeamWorld) -> None:
         """At an AI tick, before the stimuli: the glimpses become ``"suspicion"`` events."""
         if self.awareness is not None:
             world.events.extend(self.awareness.suspicions(world.t))
 
-    def after_stimuli(self, world: World) -> None:
+    def after_stimuli(self, world: TeamWorld) -> None:
         """After the stimuli's tick: the alert phase sets the guards' speed."""
         if self.alert is not None:
             for guard in world.guards:
                 guard.speed = world.guard_speed * self.alert.speed_scale
 
-    def trace_fields(self, world: World) -> tuple[dict[str, Any], list[dict[str, Any]]]:
+    def trace_fields(self, world: TeamWorld) -> tuple[dict[str, Any], list[dict[str, Any]]]:
         """Extra trace fields: top level (``phase``) and per guard (``awareness``, ``role``)."""
         top: dict[str, Any] = {}
         if self.alert is not None:
@@ -115,4 +156,4 @@ class TeamRules:
         return top, per_guard
 
 
-__all__ = ["SECTIONS", "TeamRules"]
+__all__ = ["SECTIONS", "TeamRules", "TeamWorld"]

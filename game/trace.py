@@ -95,7 +95,7 @@ class TraceWriter:
 
     def write(self, world: World, extra: dict[str, Any] | None = None) -> None:
         """Write ``world``'s line now."""
-        record = {**(extra or {}), **world.trace_record()}
+        record = {**(extra or {}), **trace_record(world)}
         if self.explain:
             record["explain"] = world.guard_ai.explain(0)
         self.handle.write(json.dumps(record) + "\n")

@@ -1,7 +1,7 @@
 """The simulated world: one trial in progress, advanced by :meth:`World.step` (decisions,
 motion in :mod:`game.agents`, damage in :mod:`game.health`, senses in :mod:`game.senses`, the
-AI tick); player actions in :mod:`game.actions`, metrics in :mod:`game.metrics`, traces in
-:mod:`game.trace`. Never imports pygame: the front end and the headless runner share it."""
+AI tick); player actions in :mod:`game.actions`, metrics in :mod:`game.metrics`; traces are
+written by :mod:`game.trace`, which reads the world (the world never imports it). Never imports pygame: the front end and the headless runner share it."""
 
 from __future__ import annotations
 
@@ -17,8 +17,8 @@ from ai.view import Event
 from navmesh.graph import NodeGraph, graph_for
 from navmesh.level import Level
 
-from . import trace
-from .actions import ActionParams, PlayerActions, Refused
+from .action_params import ActionParams
+from .actions import PlayerActions, Refused
 from .agents import Agent, Locomotion, build_space
 from .config import Config
 from .guard_sight import GuardSight, ViewCover
@@ -237,7 +237,7 @@ class World(PlayerActions):
                 if not self.done:  # respawned: a teleport, not a walk (no footsteps, no stall)
                     before[-1] = self.player.pos
 
-        _settle_agents(self, agents, before, [g.speed for g in self.guards] + [player_speed])
+        self._settle_agents(agents, before, [g.speed for g in self.guards] + [player_speed])
         self.player_moved = self.player.pos != before[-1]
         if sprint and self.player_moved:
             self._sprinted = True  # footsteps: the player moved while sprinting this tick
@@ -251,6 +251,30 @@ class World(PlayerActions):
     def stop(self) -> None:
         """End the trial now (a script that has seen what it waited for)."""
         self.done = True
+
+    def _settle_agents(self, agents: list[Agent], before: list[tuple[float, float]],
+                       speeds: list[float]) -> None:
+        """Stop the agents that arrived and enter the nodes they stand on (the player last:
+        its arrivals are not scored).
+
+        An agent that has reached its target stands on it, and keeps its node until it moves.
+        That is not always the node under its centre: on the partition a body stops on the
+        target's stand point, which lies in a neighbouring triangle when the target's centroid
+        is within a body radius of a wall (the slivers by a thin wall's end). Read from the
+        centre, the controller never saw it arrive and sent it there again, for ever (issue 24).
+        """
+        walk, node_near, last = self.locomotion, self.graph.node_near, len(agents) - 1
+        for i, (agent, speed) in enumerate(zip(agents, speeds, strict=True)):
+            if walk.settle(agent, before[i], speed, self.stuck_timeout):
+                if i < last:
+                    self.m.count_arrival(agent.history, agent.target)
+                node = agent.target
+            elif agent.pos == before[i]:
+                continue
+            else:
+                node = node_near(agent.pos[0], agent.pos[1], agent.node)
+            if node != agent.node:
+                self._enter_node(agent, node, i)
 
     def _enter_node(self, agent: Agent, node: int, index: int) -> None:
         """``agent`` (guard number ``index``, or the player) now stands on ``node``."""
@@ -326,35 +350,6 @@ class World(PlayerActions):
     def metrics(self) -> dict[str, Any]:
         """Every registered metric (:mod:`game.metrics`) of the trial so far (SPEC §9)."""
         return world_metrics(self)
-
-    def trace_record(self) -> dict[str, Any]:
-        """One trace line (:func:`game.trace.trace_record`)."""
-        return trace.trace_record(self)
-
-
-def _settle_agents(world: World, agents: list[Agent], before: list[tuple[float, float]],
-                   speeds: list[float]) -> None:
-    """Stop the agents that arrived and enter the nodes they stand on (the player last: its
-    arrivals are not scored).
-
-    An agent that has reached its target stands on it, and keeps its node until it moves.
-    That is not always the node under its centre: on the partition a body stops on the
-    target's stand point, which lies in a neighbouring triangle when the target's centroid
-    is within a body radius of a wall (the slivers by a thin wall's end). Read from the
-    centre, the controller never saw it arrive and sent it there again, for ever (issue 24).
-    """
-    walk, node_near, last = world.locomotion, world.graph.node_near, len(agents) - 1
-    for i, (agent, speed) in enumerate(zip(agents, speeds, strict=True)):
-        if walk.settle(agent, before[i], speed, world.stuck_timeout):
-            if i < last:
-                world.m.count_arrival(agent.history, agent.target)
-            node = agent.target
-        elif agent.pos == before[i]:
-            continue
-        else:
-            node = node_near(agent.pos[0], agent.pos[1], agent.node)
-        if node != agent.node:
-            world._enter_node(agent, node, i)
 
 
 def _guard_senses(guards: list[Agent], senses: Senses, ppos: tuple[float, float], reach: float,

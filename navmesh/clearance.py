@@ -30,6 +30,8 @@ from shapely.geometry import Point, Polygon
 from shapely.geometry.base import BaseGeometry
 from shapely.ops import nearest_points
 
+from navmesh.query import find_path
+
 if TYPE_CHECKING:
     from navmesh.level import Level
     from navmesh.mesh import NavMesh
@@ -224,7 +226,7 @@ class Clearance:
             return []
         a, b = self.snap(sx, sy), self.snap(gx, gy)
         try:
-            points = mesh.find_path(a, b).points
+            points = find_path(mesh, a, b).points
         except ValueError:  # OutsideError (a snapped point on a dust piece), no corridor
             return []
         out = [(float(x), float(y)) for x, y in points[1:]]

@@ -29,8 +29,7 @@ UNREACHABLE_HOPS = np.iinfo(np.int32).max // 4
 
 #: Graphs with at most this many nodes keep dense all-pairs matrices (20 bytes × n²:
 #: 84 MB at the limit); larger ones search per source. Results are the same either way.
-#: (Here, not in :mod:`navmesh.graph`, which uses and re-exports it, so that
-#: :mod:`navmesh.sizing` reads it without importing the graph that imports sizing.)
+#: Compared in one place only: :func:`keeps_dense`.
 DENSE_MAX_NODES = 2048
 
 #: Bytes of per-source distance rows a searched graph keeps (least recently used go first).
@@ -335,6 +334,18 @@ class SearchedDistances(Distances):
             self.adjacency, indices=nodes, min_only=True,
             limit=np.inf if limit is None else float(limit)),))
         return row
+
+
+def keeps_dense(nodes: int) -> bool:
+    """Whether a graph of ``nodes`` nodes keeps dense all-pairs matrices: the one test of
+    :data:`DENSE_MAX_NODES`, asked by the graph choosing its strategy
+    (:class:`navmesh.graph.NodeGraph`) and by the memory estimate made before a level is built
+    (:func:`navmesh.sizing.estimate_bytes`).
+
+    >>> keeps_dense(2048), keeps_dense(2049)
+    (True, False)
+    """
+    return nodes <= DENSE_MAX_NODES
 
 
 def distances_for(adjacency: csr_matrix, table: Callable[[], np.ndarray], dense: bool) -> Distances:

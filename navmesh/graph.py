@@ -7,7 +7,8 @@ running on.
 
 Distances are computed on demand, so memory grows with the level rather than its square:
 the graph picks one storage strategy of :mod:`navmesh.distances` when it is built — dense
-all-pairs matrices up to :data:`DENSE_MAX_NODES` nodes (every bundled level), per-source
+all-pairs matrices up to 2,048 nodes (every bundled level; :func:`~navmesh.distances.keeps_dense`
+decides), per-source
 searches with a bounded row cache above — and delegates every query to it. Every answer is
 bit-identical whichever strategy a graph holds (tests/test_graph_queries.py checks it).
 """
@@ -27,13 +28,13 @@ from scipy.sparse.csgraph import connected_components
 from .abstractions import ABSTRACTIONS
 from .clearance import DEFAULT_AGENT_RADIUS, clearance_for
 from .distances import (
-    DENSE_MAX_NODES,
     ROW_CACHE_BYTES,
     UNREACHABLE_HOPS,
     Distances,
     RowCache,
     SlicedSearch,
     distances_for,
+    keeps_dense,
 )
 
 if TYPE_CHECKING:
@@ -41,7 +42,7 @@ if TYPE_CHECKING:
     from .mesh import NavMesh
 
 
-__all__ = ["ABSTRACTIONS", "DENSE_MAX_NODES", "ROW_CACHE_BYTES", "UNREACHABLE_HOPS", "Neighbours",
+__all__ = ["ABSTRACTIONS", "ROW_CACHE_BYTES", "UNREACHABLE_HOPS", "Neighbours",
            "NodeGraph", "RowCache", "SlicedSearch", "build_graph", "falloff_depth", "graph_for",
            "hop_ball_pairs"]
 
@@ -108,7 +109,7 @@ class NodeGraph:
     """Nodes, adjacency and distance queries of one level in one abstraction.
 
     Build it with :meth:`from_grid` or :meth:`from_mesh`. ``dense`` chooses the storage of
-    distances (None: dense up to :data:`DENSE_MAX_NODES` nodes); it never changes a result.
+    distances (None: as :func:`~navmesh.distances.keeps_dense` says for its size); it never changes a result.
 
     >>> import numpy as np
     >>> g = NodeGraph.from_grid(np.array([[True, True, True]]), 1.0)
@@ -138,7 +139,7 @@ class NodeGraph:
         lengths = np.linalg.norm(self.positions[rows] - self.positions[cols], axis=1)
         self.adjacency = csr_matrix((lengths, (rows, cols)), shape=(n, n))
         if self.dense is None:
-            self.dense = n <= DENSE_MAX_NODES
+            self.dense = keeps_dense(n)
         self._labels: np.ndarray | None = None
         #: the storage strategy every distance query goes to (chosen here, once)
         self.distances: Distances = distances_for(self.adjacency, lambda: self._neighbour_table,

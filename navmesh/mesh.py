@@ -2,8 +2,9 @@
 
 The mesh is plain arrays plus a bucket-grid locator.  Building it (:meth:`NavMesh.build`)
 runs the pipeline of :mod:`navmesh.rings` → :mod:`navmesh.triangulate` →
-:mod:`navmesh.refine`; path queries live in :mod:`navmesh.query` (``mesh.query``, which
-:meth:`NavMesh.find_path` and :meth:`NavMesh.corridor` delegate to).
+:mod:`navmesh.refine`.  Path queries are another object, made from a built mesh
+(:func:`navmesh.query.path_query`, as Detour's ``dtNavMeshQuery`` is made from a
+``dtNavMesh``): this module imports nothing of :mod:`navmesh.query`.
 
 Conventions
 -----------
@@ -19,9 +20,6 @@ Conventions
 >>> mesh = NavMesh.build(box(0, 0, 10, 10).difference(box(4, 0, 6, 8)))
 >>> mesh.locate(1.0, 1.0) >= 0, mesh.locate(5.0, 5.0)
 (True, -1)
->>> path = mesh.find_path((1, 1), (9, 1))
->>> path.points.tolist(), round(path.length, 6)
-([[1.0, 1.0], [4.0, 8.0], [6.0, 8.0], [9.0, 1.0]], 17.231546)
 """
 
 from __future__ import annotations
@@ -30,14 +28,12 @@ import gc
 import math
 from collections.abc import Iterator
 from contextlib import contextmanager
-from functools import cached_property
 from pathlib import Path
 
 import numpy as np
 from shapely.geometry import Polygon
 
 from navmesh.degenerate import fix_degenerate
-from navmesh.query import MAX_CORNERS, NavPath, OutsideError, PathQuery
 from navmesh.refine import Refiner
 from navmesh.rings import polygon_rings
 from navmesh.triangulate import (
@@ -50,7 +46,7 @@ from navmesh.triangulate import (
     wall_edges,
 )
 
-__all__ = ["DEFAULT_MIN_ANGLE", "MAX_CORNERS", "MAX_REFINE_WORK", "MAX_STEINER", "METHODS", "NavMesh", "NavPath", "OutsideError"]
+__all__ = ["DEFAULT_MIN_ANGLE", "MAX_REFINE_WORK", "MAX_STEINER", "METHODS", "NavMesh"]
 
 #: Triangulation methods accepted by :meth:`NavMesh.build`.
 METHODS = ("refined", "cdt", "earcut")
@@ -120,6 +116,9 @@ class NavMesh:
         #: True when the refinement's budget (:data:`MAX_STEINER`) stopped it with triangles
         #: below ``min_angle`` (or above ``max_area``) left: a conforming mesh all the same
         self.refinement_stopped = False
+        #: objects built from this mesh and kept while it lives, by their type (the path
+        #: query of :func:`navmesh.query.path_query`); the mesh itself never reads them
+        self.derived: dict[type, object] = {}
         self._build_locator(lo, hi)
 
     # ---------------------------------------------------------------- building
@@ -291,23 +290,6 @@ class NavMesh:
         k = int(hits[0])
         tri = self.triangles[t]
         return self.vertices[[tri[(k + 1) % 3], tri[(k + 2) % 3]]].copy()
-
-    # ------------------------------------------------------------------ paths
-    @cached_property
-    def query(self) -> PathQuery:
-        """The path query bound to this mesh (built on first use, with its tables and caches)."""
-        return PathQuery(self)
-
-    def find_path(self, start: tuple[float, float], goal: tuple[float, float], *, exact: bool = True) -> NavPath:
-        """Shortest walkable path from ``start`` to ``goal``, both included (:meth:`PathQuery.find_path`).
-
-        Raises :class:`OutsideError` if either point lies outside the walkable area.
-        """
-        return self.query.find_path(start, goal, exact=exact)
-
-    def corridor(self, start: tuple[float, float], goal: tuple[float, float], *, exact: bool = True) -> list[int]:
-        """Triangles of the corridor :meth:`find_path` pulls its path through (:meth:`PathQuery.corridor`)."""
-        return self.query.corridor(start, goal, exact=exact)
 
     # ----------------------------------------------------------------- export
     def export(self, path: str | Path) -> None:

@@ -3,15 +3,18 @@
 The Detour ``dtNavMeshQuery`` side of the package: a :class:`PathQuery` is bound to one
 mesh and owns everything a search needs — Python-level portal tables, the pinch points,
 the lazily built corner-visibility tables (:class:`navmesh.sight.MeshSight`) and the
-triangle fans used to re-route a corridor.  ``NavMesh.find_path`` / ``NavMesh.corridor``
-delegate here (``mesh.query``).
+triangle fans used to re-route a corridor.  It is made from a built mesh, which knows
+nothing of it (Detour's ``dtNavMeshQuery`` beside ``dtNavMesh``): :func:`path_query` gives
+the one query of a mesh, and :func:`find_path` / :func:`corridor` ask it.
 
 >>> from shapely import box
 >>> from navmesh.mesh import NavMesh
->>> query = NavMesh.build(box(0, 0, 10, 10).difference(box(4, 0, 6, 8))).query
->>> path = query.find_path((1, 1), (9, 1))
+>>> mesh = NavMesh.build(box(0, 0, 10, 10).difference(box(4, 0, 6, 8)))
+>>> path = find_path(mesh, (1, 1), (9, 1))
 >>> path.points.tolist(), round(path.length, 6)
 ([[1.0, 1.0], [4.0, 8.0], [6.0, 8.0], [9.0, 1.0]], 17.231546)
+>>> path_query(mesh) is path_query(mesh)
+True
 """
 
 from __future__ import annotations
@@ -31,7 +34,7 @@ from navmesh.sight import MeshSight
 if TYPE_CHECKING:
     from navmesh.mesh import NavMesh
 
-__all__ = ["MAX_CORNERS", "NavPath", "OutsideError", "PathQuery"]
+__all__ = ["MAX_CORNERS", "NavPath", "OutsideError", "PathQuery", "corridor", "find_path", "path_query"]
 
 #: Above this many wall corners the exact-path tables are not built (A* + funnel instead).
 MAX_CORNERS = 1000
@@ -48,7 +51,7 @@ class NavPath:
 class PathQuery:
     """Shortest paths and corridors on one mesh, with the tables and caches the search uses.
 
-    Built from a finished mesh (``NavMesh.query`` builds one on first use); the
+    Built from a finished mesh (:func:`path_query` keeps one per mesh); the
     corner-visibility tables are built on the first exact query.
     """
 
@@ -327,6 +330,29 @@ class PathQuery:
             pos = (pos - step) % n
             arc.append(fan[pos])
         return _drop_loops(corridor[:i] + arc + corridor[j + 2 :])
+
+
+def path_query(mesh: NavMesh) -> PathQuery:
+    """The path query of ``mesh``: built on first use and kept with the mesh (in
+    ``mesh.derived``), so its tables and caches serve every later query."""
+    query = mesh.derived.get(PathQuery)
+    if not isinstance(query, PathQuery):
+        query = mesh.derived[PathQuery] = PathQuery(mesh)
+    return query
+
+
+def find_path(mesh: NavMesh, start: tuple[float, float], goal: tuple[float, float], *,
+              exact: bool = True) -> NavPath:
+    """Shortest walkable path on ``mesh`` from ``start`` to ``goal``, both included
+    (:meth:`PathQuery.find_path`); :class:`OutsideError` if either point is outside."""
+    return path_query(mesh).find_path(start, goal, exact=exact)
+
+
+def corridor(mesh: NavMesh, start: tuple[float, float], goal: tuple[float, float], *,
+             exact: bool = True) -> list[int]:
+    """Triangles of the corridor :func:`find_path` pulls its path through
+    (:meth:`PathQuery.corridor`)."""
+    return path_query(mesh).corridor(start, goal, exact=exact)
 
 
 def _polyline_length(points: list[tuple[float, float]]) -> float:

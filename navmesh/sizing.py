@@ -15,7 +15,7 @@ from typing import TYPE_CHECKING
 
 import shapely
 
-from .distances import DENSE_MAX_NODES, ROW_CACHE_BYTES
+from .distances import ROW_CACHE_BYTES, keeps_dense
 
 if TYPE_CHECKING:
     from shapely.geometry import Polygon
@@ -66,13 +66,13 @@ def estimate_bytes(level: Level) -> tuple[int, int]:
     """(nodes, bytes) a level needs to run, from its size alone, before building anything.
 
     Nodes: the larger of the walkable cells and twice the walkable polygon's vertices (a
-    triangulation's triangle count). Bytes: per node, plus the dense matrices below
-    :data:`DENSE_MAX_NODES`, plus the bounded row caches.
+    triangulation's triangle count). Bytes: per node, plus the dense matrices when
+    :func:`~navmesh.distances.keeps_dense` says the graph keeps them, plus the bounded row caches.
     """
     cells = int(level.occupancy.sum())
     vertices = int(shapely.get_num_coordinates(level.walkable))  # closing points included
     nodes = max(cells, 2 * vertices)
-    dense = dense_bytes(nodes) if nodes <= DENSE_MAX_NODES else 0
+    dense = dense_bytes(nodes) if keeps_dense(nodes) else 0
     return nodes, nodes * BYTES_PER_NODE + dense + 2 * ROW_CACHE_BYTES
 
 

@@ -1,11 +1,17 @@
-"""The house rules of issue 22, read from the code with ``ast``.
+"""The house rules of issues 22 and 33, read from the code with ``ast``: rules that measure
+structure, not size.
 
-Every import at any depth counts (lazy imports inside functions included); only imports
-under ``if TYPE_CHECKING:`` are left out, since they never run. On that import graph:
-no layering violation (SPEC §1, no carve-out), no import cycle between modules; and on the
-source: no module above 500 lines, ``World`` at most 300 lines, at most two places outside
-``navmesh/`` that read a graph's ``.dense`` (the storage strategy is chosen in navmesh), one
-place that constructs ``World(...)``, at most 15 modules directly in ``headless/``.
+Every import at any depth counts (lazy imports inside functions included). On the import
+graph that runs (``if TYPE_CHECKING:`` blocks left out): no layering violation (SPEC §1, no
+carve-out) and no import cycle at all. On the graph with the type-only imports counted too
+(a type named across a module boundary is a dependency all the same): no cycle contains
+``game/config.py`` or ``game/schema.py``, and every strongly connected component has at
+most two modules (so every cycle is one pair of modules naming each other, never a loop
+round three or more); ``navmesh/mesh.py`` imports nothing of ``navmesh/query.py`` (build
+apart from query). On the source: one predicate compares a node count with the dense
+threshold, at most two places outside ``navmesh/`` read a graph's ``.dense`` (the storage
+strategy is chosen in navmesh), one place constructs ``World(...)``, and docs/architecture.md's
+table of ``Level``'s fields lists every field.
 """
 
 from __future__ import annotations
@@ -100,11 +106,13 @@ def _layer(module: str) -> str:
 
 
 @cache
-def _graph() -> dict[str, set[str]]:
+def _graph(type_checking: bool = False) -> dict[str, set[str]]:
+    """Our modules and the modules of ours each imports (type-only ones with ``type_checking``)."""
     ours = _modules()
     graph: dict[str, set[str]] = {}
     for path in _files():
-        graph[_module_name(path)] = {m for m in imports(path) if m in ours}
+        graph[_module_name(path)] = {m for m in imports(path, type_checking=type_checking)
+                                     if m in ours}
     return graph
 
 
@@ -161,21 +169,32 @@ def test_no_layering_violation_at_any_depth() -> None:
     assert layering_violations() == []
 
 
+def test_mesh_imports_nothing_of_query() -> None:
+    """Build apart from query (Recast / Detour): navmesh/mesh.py reaches nothing of
+    navmesh/query.py, type-only and function-level imports counted."""
+    found = imports(ROOT / "navmesh" / "mesh.py", type_checking=True)
+    assert [m for m in found if m == "navmesh.query" or m.startswith("navmesh.query.")] == []
+    assert "navmesh.mesh" in imports(ROOT / "navmesh" / "query.py", type_checking=True)
+
+
 def test_no_import_cycle_between_modules() -> None:
+    """What runs has no cycle at all (imports under ``if TYPE_CHECKING:`` never run)."""
     assert import_cycles(_graph()) == []
 
 
-def test_no_module_above_500_lines() -> None:
-    long = {str(p.relative_to(ROOT)): n for p in _files()
-            if (n := len(p.read_text(encoding="utf-8").splitlines())) > 500}
-    assert long == {}
+def test_no_cycle_contains_the_config_or_its_schema() -> None:
+    """Type-only imports counted: the config and its schema sit below everything that reads
+    them, even the types they name."""
+    bad = [c for c in import_cycles(_graph(type_checking=True))
+           if {"game.config", "game.schema"} & set(c)]
+    assert bad == []
 
 
-def test_world_is_at_most_300_lines() -> None:
-    tree = ast.parse((ROOT / "game" / "world.py").read_text(encoding="utf-8"))
-    (world,) = [n for n in tree.body if isinstance(n, ast.ClassDef) and n.name == "World"]
-    assert world.end_lineno is not None
-    assert world.end_lineno - world.lineno + 1 <= 300
+def test_every_import_cycle_is_a_pair() -> None:
+    """Type-only imports counted, every strongly connected component of the import graph
+    has at most two modules: two modules may name each other (``game.world`` and the
+    ``PlayerActions`` it inherits), no loop runs round three or more."""
+    assert [c for c in import_cycles(_graph(type_checking=True)) if len(c) > 2] == []
 
 
 def _places(predicate) -> list[str]:  # type: ignore[no-untyped-def]
@@ -204,13 +223,51 @@ def test_graph_size_is_read_in_at_most_two_places_outside_navmesh() -> None:
     assert len(_places(_reads_dense)) <= 2, _places(_reads_dense)
 
 
+def _reads_dense_threshold(path: Path, node: ast.AST) -> bool:
+    return (isinstance(node, ast.Name) and node.id == "DENSE_MAX_NODES"
+            and isinstance(node.ctx, ast.Load)) or (
+        isinstance(node, ast.Attribute) and node.attr == "DENSE_MAX_NODES")
+
+
+def test_one_predicate_decides_dense_or_searched() -> None:
+    """The dense/sparse threshold is read in ``navmesh.distances.keeps_dense`` alone; the
+    graph and the memory estimate ask that function."""
+    places = _places(_reads_dense_threshold)
+    assert len(places) == 1 and places[0].startswith("navmesh/distances.py:"), places
+    tree = ast.parse((ROOT / "navmesh" / "distances.py").read_text(encoding="utf-8"))
+    (keeps,) = [n for n in tree.body if isinstance(n, ast.FunctionDef) and n.name == "keeps_dense"]
+    assert keeps.lineno <= int(places[0].split(":")[1]) <= (keeps.end_lineno or 0)
+    for name in ("graph.py", "sizing.py"):
+        calls = {n.func.id for n in ast.walk(ast.parse((ROOT / "navmesh" / name).read_text(
+            encoding="utf-8"))) if isinstance(n, ast.Call) and isinstance(n.func, ast.Name)}
+        assert "keeps_dense" in calls, name
+
+
 def test_one_place_constructs_a_world() -> None:
     assert len(_places(_constructs_world)) == 1, _places(_constructs_world)
 
 
-def test_at_most_15_modules_directly_in_headless() -> None:
-    direct = sorted(p.name for p in (ROOT / "headless").glob("*.py") if p.name != "__init__.py")
-    assert len(direct) <= 15, direct
+def _doc_table(doc: str, heading: str) -> list[str]:
+    """The first column of the first Markdown table after ``heading`` in ``doc``, backticks
+    stripped (the header row left out)."""
+    lines = doc[doc.index(heading):].splitlines()[1:]
+    start = next(i for i, line in enumerate(lines) if line.startswith("|"))
+    rows = []
+    for line in lines[start + 2:]:
+        if not line.startswith("|"):
+            break
+        rows.append(line.split("|")[1].strip().strip("`"))
+    return rows
+
+
+def test_the_level_table_of_the_architecture_lists_every_field() -> None:
+    from dataclasses import fields
+
+    from navmesh.level_format import Level
+
+    doc = (ROOT / "docs" / "architecture.md").read_text(encoding="utf-8")
+    table = _doc_table(doc, "### `navmesh.level.Level`")
+    assert table == [f.name for f in fields(Level)]
 
 
 def test_every_sub_package_opens_with_a_one_line_docstring() -> None:
@@ -237,7 +294,22 @@ def test_the_checker_sees_relative_lazy_and_nested_imports(source: str,
     assert imports(ROOT / "game" / "probe.py", source) == expected
 
 
+def test_the_table_reader_reads_the_first_column() -> None:
+    doc = "## T\n\ntext\n\n| field | type |\n|---|---|\n| `a` | int |\n| `b` | str |\n\nafter\n"
+    assert _doc_table(doc, "## T") == ["a", "b"]
+
+
 def test_the_cycle_finder_finds_a_lazy_cycle() -> None:
     graph = {"a": {"b"}, "b": {"c"}, "c": {"a"}, "d": {"a"}}
     assert import_cycles(graph) == [["a", "b", "c"]]
     assert import_cycles({"a": {"b"}, "b": set()}) == []
+    # two pairs that share a module are one component of three: not "a pair"
+    assert import_cycles({"w": {"x", "y"}, "x": {"w"}, "y": {"w"}}) == [["w", "x", "y"]]
+
+
+def test_the_type_only_graph_sees_the_type_checking_imports(tmp_path: Path) -> None:
+    probe = tmp_path / "probe.py"
+    probe.write_text("from typing import TYPE_CHECKING\nif TYPE_CHECKING:\n"
+                     "    from game.world import World\n", encoding="utf-8")
+    assert "game.world" in imports(probe, package="game", type_checking=True)
+    assert "game.world" not in imports(probe, package="game")

@@ -19,6 +19,7 @@ from ai.view import Event, WorldView
 from game.config import Config
 from game.errors import ConfigError
 from game.team import TeamRules
+from game.trace import trace_record
 from navmesh.graph import NodeGraph
 
 DT = 0.05
@@ -284,7 +285,7 @@ def test_every_switch_is_off_by_default() -> None:
     rules = TeamRules.build(config, 3, stimuli)
     assert rules == TeamRules() and len(stimuli) == 0
     world = make(corridor_level(), make_guard_ai("pf"), StayPlayer(), overrides=["world.guards=1"])
-    record = world.trace_record()
+    record = trace_record(world)
     assert "phase" not in record and "awareness" not in record["guards"][0]
 
 

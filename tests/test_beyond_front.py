@@ -15,7 +15,7 @@ import pytest
 
 from game.front.render import BAD, DrawOptions, Renderer
 from game.scene import SceneBuilder
-from game.trace import parse_line
+from game.trace import parse_line, trace_record
 from game.trial import TrialSpec, make_world
 
 ON = (("awareness.enabled", "true"), ("alert.enabled", "true"), ("roles.enabled", "true"))
@@ -32,7 +32,7 @@ def world_at_detection():
 
 def test_trace_lines_carry_awareness_role_and_phase_and_parse_back() -> None:
     world = world_at_detection()
-    record = json.loads(json.dumps(world.trace_record()))
+    record = json.loads(json.dumps(trace_record(world)))
     assert record["phase"] == "alert"
     seer = world.seen_by[0] if world.seen_by else 0
     assert 0.0 <= record["guards"][seer]["awareness"] <= 1.0

@@ -15,7 +15,7 @@ import pytest
 
 from ai.params import FSMParams, PFParams, PlayerParams, StalenessParams
 from ai.stimuli import StimulusParams
-from game.actions import ActionParams
+from game.action_params import ActionParams
 from game.config import Config
 from game.errors import ConfigError
 from headless.cli import main

@@ -18,9 +18,8 @@ import numpy as np
 import pygame
 
 from game.front import cones
-from game.front.draw_options import Layout
 from game.front.palette import CONE, CONE_EDGE, CONE_SEEING, CONE_SEEING_EDGE, HALO
-from game.front.render import init_pygame
+from game.front.render import Layout, init_pygame
 from game.ray_cast import vision_cone
 from game.scene import GuardDrawing
 
@@ -81,7 +80,7 @@ def test_batched_cones_have_the_pixels_of_one_layer_per_cone() -> None:
         flush = cones._flush
         cones._flush = lambda surface, batch: (flushed.append(len(batch)), flush(surface, batch))[1]  # type: ignore[assignment]
         try:
-            cones.draw_cones(got, guards, layout)
+            cones.draw_cones(got, guards, layout.scale, layout.origin, layout.world_rect)
         finally:
             cones._flush = flush  # type: ignore[assignment]
         batched += sum(1 for n in flushed if n > 1)

@@ -11,6 +11,7 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
+import navmesh.distances as distances_module
 import navmesh.graph as graph_module
 import navmesh.sizing as sizing
 from game.trial import TrialSpec, run_trial
@@ -47,7 +48,7 @@ def test_trials_do_not_depend_on_the_graph_storage(
     specs = [TrialSpec(level=name, abstraction=ab, guards=guards, player=player, seed=1)
              for name, ab in (("maze", "grid"), ("tlou", "partition"))]
     dense = [run_trial(spec) for spec in specs]
-    monkeypatch.setattr(graph_module, "DENSE_MAX_NODES", 0)
+    monkeypatch.setattr(distances_module, "DENSE_MAX_NODES", 0)
     graph_module._cached_graph.cache_clear()
     try:
         searched = [run_trial(spec) for spec in specs]

@@ -16,7 +16,8 @@ from hypothesis import strategies as st
 from shapely import MultiPolygon, Polygon, box
 from shapely.affinity import rotate
 
-from navmesh.mesh import METHODS, NavMesh, OutsideError
+from navmesh.mesh import METHODS, NavMesh
+from navmesh.query import OutsideError, find_path
 
 LEVELS_DIR = Path(__file__).resolve().parents[1] / "assets" / "levels"
 BUNDLED = sorted(p.stem for p in LEVELS_DIR.glob("*.json"))
@@ -275,7 +276,7 @@ def test_adjacency_and_shared_edge() -> None:
 def test_outside_error_message() -> None:
     mesh = NavMesh.build(box(0, 0, 4, 4))
     with pytest.raises(OutsideError, match=r"^point \(5\.0, 4\.5\) is outside the walkable area$"):
-        mesh.find_path((5.0, 4.5), (1, 1))
+        find_path(mesh, (5.0, 4.5), (1, 1))
     assert issubclass(OutsideError, ValueError)
     assert mesh.locate(float("nan"), 1.0) == -1
     assert list(mesh.locate_many([[float("nan"), 0.0], [1e9, 1e9], [2.0, 2.0]])[:2]) == [-1, -1]

@@ -21,7 +21,8 @@ from hypothesis import strategies as st
 from shapely import LineString, Polygon, box
 
 from navmesh.funnel import funnel
-from navmesh.mesh import METHODS, NavMesh, NavPath, OutsideError
+from navmesh.mesh import METHODS, NavMesh
+from navmesh.query import NavPath, OutsideError, corridor, find_path
 from oracle import VisibilityGraph
 
 try:  # the polygon strategies live next door
@@ -56,7 +57,7 @@ def check_path(poly: Polygon, path: NavPath, start: np.ndarray, goal: np.ndarray
 def ratios(poly: Polygon, mesh: NavMesh, oracle: VisibilityGraph, pairs: np.ndarray, *, exact: bool) -> np.ndarray:
     out = []
     for s, g in pairs:
-        path = mesh.find_path(s, g, exact=exact)
+        path = find_path(mesh, s, g, exact=exact)
         check_path(poly, path, s, g)
         best = oracle.distance(s, g)
         out.append(path.length / best if best > 1e-12 else 1.0)
@@ -175,11 +176,11 @@ def test_corridor_funnel_gives_the_path(poly: Polygon, exact: bool, seed: int) -
     """Pulling the funnel through corridor() reproduces find_path()."""
     mesh = NavMesh.build(poly)
     for s, g in random_pairs(poly, 20, seed):
-        path = mesh.find_path(s, g, exact=exact)
-        corridor = mesh.corridor(s, g, exact=exact)
-        steps = list(itertools.pairwise(corridor))
+        path = find_path(mesh, s, g, exact=exact)
+        route = corridor(mesh, s, g, exact=exact)
+        steps = list(itertools.pairwise(route))
         assert all(u in mesh.neighbors[t] for t, u in steps), "corridor not edge-connected"
-        assert in_triangle(mesh, corridor[0], s) and in_triangle(mesh, corridor[-1], g)
+        assert in_triangle(mesh, route[0], s) and in_triangle(mesh, route[-1], g)
         rights = [tuple(mesh.shared_edge(t, u)[0]) for t, u in steps]
         lefts = [tuple(mesh.shared_edge(t, u)[1]) for t, u in steps]
         pts, _ = funnel(tuple(s), tuple(g), rights, lefts)
@@ -222,16 +223,16 @@ def test_grid_coordinates_through_corners() -> None:
     r = ratios(poly, mesh, oracle, pairs, exact=True)
     assert r.max() <= 1.0 + 1e-9
     # the two diagonal blocks at (2, 2) and (3, 3) touch at (3, 3): no squeezing through
-    path = mesh.find_path((2.5, 3.5), (3.5, 2.5))
+    path = find_path(mesh, (2.5, 3.5), (3.5, 2.5))
     assert path.length > math.sqrt(2) + 0.5
 
 
 def test_same_triangle_and_same_point() -> None:
     mesh = NavMesh.build(box(0, 0, 4, 3), method="cdt")
-    path = mesh.find_path((0.5, 0.5), (0.7, 0.4))
+    path = find_path(mesh, (0.5, 0.5), (0.7, 0.4))
     assert path.points.tolist() == [[0.5, 0.5], [0.7, 0.4]]
     assert math.isclose(path.length, math.hypot(0.2, 0.1))
-    path = mesh.find_path((1.0, 1.0), (1.0, 1.0))
+    path = find_path(mesh, (1.0, 1.0), (1.0, 1.0))
     assert path.length == 0.0 and len(path.points) == 2
 
 
@@ -240,11 +241,11 @@ def test_outside_points_raise(exact: bool) -> None:
     poly = box(0, 0, 10, 10).difference(box(4, 0, 6, 8))
     mesh = NavMesh.build(poly)
     with pytest.raises(OutsideError, match=r"^point \(5\.0, 4\.0\) is outside the walkable area$"):
-        mesh.find_path((5.0, 4.0), (1.0, 1.0), exact=exact)
+        find_path(mesh, (5.0, 4.0), (1.0, 1.0), exact=exact)
     with pytest.raises(OutsideError, match=r"^point \(11\.0, 1\.0\) is outside the walkable area$"):
-        mesh.find_path((1.0, 1.0), (11.0, 1.0), exact=exact)
+        find_path(mesh, (1.0, 1.0), (11.0, 1.0), exact=exact)
     with pytest.raises(OutsideError):
-        mesh.corridor((1.0, 1.0), (-3.0, 1.0), exact=exact)
+        corridor(mesh, (1.0, 1.0), (-3.0, 1.0), exact=exact)
 
 
 def test_path_around_a_wall() -> None:
@@ -252,6 +253,6 @@ def test_path_around_a_wall() -> None:
     for method in METHODS:
         mesh = NavMesh.build(poly, method=method)
         for exact in (True, False):
-            path = mesh.find_path((1, 1), (9, 1), exact=exact)
+            path = find_path(mesh, (1, 1), (9, 1), exact=exact)
             assert path.points.tolist() == [[1, 1], [4, 8], [6, 8], [9, 1]]
             assert math.isclose(path.length, 2 * math.hypot(3, 7) + 2)

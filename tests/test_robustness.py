@@ -12,7 +12,7 @@ from headless.errors import UserError
 from headless.presets import load_preset
 from headless.analysis.robustness import END, SECTION, START, judge, main, write_between_markers
 from headless.store import STORE_NAME, ResultStore
-from headless.tune.study import load_tune_spec
+from headless.tune.spec import load_tune_spec
 
 GUARDS = ("cheat", "pf", "staleness", "fsm", "random")
 #: capture rank (Cheat > PF > Staleness > FSM > RandomWalk, as the paper)

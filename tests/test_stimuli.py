@@ -28,8 +28,9 @@ from ai.stimuli import (
     zones_from_config,
 )
 from ai.view import Event, GuardAI, WorldView
-from game.actions import ActionParams
+from game.action_params import ActionParams
 from game.config import Config
+from game.trace import trace_record
 from game.trial import TrialSpec, make_world
 from game.world import Refused, World
 from navmesh.graph import NodeGraph
@@ -522,9 +523,9 @@ def test_trace_lists_active_stimuli():
     w = world(room())
     w.down_guard(0)
     tick(w)
-    record = w.trace_record()
+    record = trace_record(w)
     assert record["stimuli"][0]["name"] == "corpse"
-    assert "stimuli" not in world(room()).trace_record()
+    assert "stimuli" not in trace_record(world(room()))
 
 
 # ---------------------------------------------------------------------------- plugins

@@ -15,7 +15,7 @@ import pytest
 from game.config_file import read_config_file
 from headless.cli import main
 from headless.tune.objective import load_target
-from headless.tune.study import load_tune_spec
+from headless.tune.spec import load_tune_spec
 
 pytest.importorskip("optuna")
 
@@ -131,7 +131,7 @@ def test_the_paper_table_is_a_target(tmp_path: Path) -> None:
 def test_a_special_file_as_spec_is_refused_in_one_line(tmp_path: Path) -> None:
     import os
 
-    from headless.tune.study import load_tune_spec
+    from headless.tune.spec import load_tune_spec
     from navmesh.errors import StealthError
 
     fifo = tmp_path / "spec.toml"

@@ -18,7 +18,6 @@ import pygame
 
 from game.scene import GuardDrawing
 
-from .draw_options import Layout
 from .palette import CONE, CONE_EDGE, CONE_SEEING, CONE_SEEING_EDGE, HALO
 
 __all__ = ["draw_cones"]
@@ -30,15 +29,16 @@ OUTLINE_REACH = 3
 _Placed = tuple[GuardDrawing, np.ndarray, np.ndarray, np.ndarray]
 
 
-def draw_cones(surface: pygame.Surface, guards: Sequence[GuardDrawing], layout: Layout) -> None:
-    """Every active guard's cone, in guard order, through ``layout``'s transform."""
+def draw_cones(surface: pygame.Surface, guards: Sequence[GuardDrawing], scale: float,
+               origin: tuple[float, float], area: pygame.Rect) -> None:
+    """Every active guard's cone, in guard order, moved to the screen by ``scale`` and
+    ``origin`` (pixels = world × scale + origin); cones wholly outside ``area`` are skipped."""
     shown = [g for g in guards if g.active and len(g.cone) >= 3]
     if not shown:
         return
-    s, (ox, oy) = layout.scale, layout.origin
+    s, (ox, oy) = scale, origin
     every = np.concatenate([g.cone for g in shown]) * s + (ox, oy)
     ends = np.cumsum([len(g.cone) for g in shown])[:-1]
-    area = layout.world_rect
     batch: list[_Placed] = []
     for guard, pts in zip(shown, np.split(every, ends)):
         lo = np.floor(pts.min(axis=0)).astype(int)

@@ -8,13 +8,16 @@ follows the player, with a :class:`~game.front.minimap.Minimap` in the corner.
 
 Drawing order keeps everything readable over every overlay: cones (light fill, white
 outline on a dark halo, colours outside the colour map), plans, bodies, plan targets, the
-player, then every text label last on a dark box, so no marker hides one.
+player, then every text label last on a dark box, so no marker hides one. What the caller
+adds to a frame besides the scene is a :class:`DrawOptions`; where HUD, map and help lines
+go in the window is the renderer's :class:`Layout`.
 """
 
 from __future__ import annotations
 
 import os
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field
 
 os.environ.setdefault("PYGAME_HIDE_SUPPORT_PROMPT", "1")
 # The window's own framebuffer (X11: MIT-SHM), not SDL's default of a texture drawn by
@@ -28,7 +31,6 @@ import pygame
 from game.scene import GuardDrawing, Scene, StaticScene
 
 from .display import choose_video_driver
-from .draw_options import DrawOptions, Layout
 from .camera import MIN_FIT_SCALE, START_SCALE, Camera
 from .cones import draw_cones
 from .labels import place_labels
@@ -43,6 +45,50 @@ from .palette import (
     TEXT, TEXT_DIM, WARN, Color, colormap_lut, colors_of,
 )
 from .screens import Panel, draw_panel
+
+
+@dataclass
+class DrawOptions:
+    """What the caller (play or replay) adds to a frame besides the scene."""
+
+    show_mesh: bool = False
+    show_plans: bool = False
+    paused: bool = False
+    #: help-line items, e.g. ``["WASD move", "Space pause"]``
+    help: Sequence[str] = ()
+    #: short status text shown in the HUD (last action, speed, ...)
+    message: str = ""
+    message_color: Color = WARN
+    #: a banner panel at the top of the map (end of trace)
+    banner: str | None = None
+    banner_sub: str = ""
+    #: extra HUD items on the first row
+    info: Sequence[str] = field(default_factory=tuple)
+    #: the second HUD row shows the overlay legend (play) or nothing (replay)
+    legend: bool = True
+    #: a screen over the map (ready, won / lost, level chooser); wins over ``banner``
+    panel: Panel | None = None
+    #: collectibles still to pick up ``(k, 2)``
+    collectibles: np.ndarray = field(default_factory=lambda: np.zeros((0, 2)))
+    #: extra drawing after the cones (noise rings, rain): ``effects(surface, renderer)``
+    effects: Callable[[pygame.Surface, Renderer], None] | None = None
+
+
+@dataclass(frozen=True)
+class Layout:
+    """Where things go in a window of ``size``: HUD bar, world rectangle, help lines."""
+
+    size: tuple[int, int]
+    hud_height: int
+    help_height: int
+    scale: float
+    origin: tuple[float, float]
+
+    @property
+    def world_rect(self) -> pygame.Rect:
+        """Screen rectangle of the world extent."""
+        return pygame.Rect(0, self.hud_height, self.size[0], self.size[1] - self.hud_height - self.help_height)
+
 
 def init_pygame() -> None:
     """Initialise only what the front end uses (display, fonts): no audio device needed;
@@ -177,7 +223,7 @@ class Renderer:
             self._diamond(surface, self.to_screen(x, y), max(6, s * 0.35), MARKER, 0)
         for x, y in options.collectibles:
             self._collectible(surface, self.to_screen(x, y), max(6.0, s * 0.35))
-        draw_cones(surface, scene.guards, self.layout)
+        draw_cones(surface, scene.guards, self.layout.scale, self.layout.origin, self.layout.world_rect)
         for ring in self.static.exits:
             x, y = self.to_screen(float(ring[:, 0].min()), float(ring[:, 1].min()))
             label = self._text("EXIT", self.small, EXIT_EDGE)

@@ -33,6 +33,7 @@ from game.trial import TrialSpec
 from game.zones import ZoneMap
 from navmesh.graph import NodeGraph
 from navmesh.level import Level
+from navmesh.query import find_path
 
 #: Slack on the fastest agent's speed (``game.agents.max_agent_speed``): a move between two
 #: lines longer than this many times what that agent walks in the time is a teleport
@@ -142,7 +143,7 @@ class Playback:
             a, b = self._pos(i, agent), self._pos(i + 1, agent)
             dt = self.times[i + 1] - self.times[i]
             try:
-                points = np.asarray(self.mesh.find_path(a, b).points, dtype=float)
+                points = np.asarray(find_path(self.mesh, a, b).points, dtype=float)
             except ValueError:  # a recorded point on the wall line: walk straight
                 points = np.array([a, b], dtype=float)
             route = _Route(points, jump=False)

@@ -21,7 +21,7 @@ from game.config_file import write_config_file
 from ..analysis.reproducible import save_figure
 
 if TYPE_CHECKING:
-    from .study import TuneSpec
+    from .spec import TuneSpec
 
 __all__ = ["write_study_outputs"]
 
