@@ -35,6 +35,9 @@ class _Params:
     #: field name -> its allowed values (:mod:`ai.bounds`), one declaration per field; the
     #: config schema (``game.schema``) reads these for the keys of the section
     bounds: ClassVar[Mapping[str, Bound]] = {}
+    #: fields the trial fills in from ``[world]`` and the scenario (``game.trial.player_params``),
+    #: so they are no config keys of the class's own section
+    from_world: ClassVar[tuple[str, ...]] = ()
 
     @classmethod
     def from_mapping(cls: type[_P], params: Mapping[str, Any] | None = None) -> _P:
@@ -193,6 +196,7 @@ class PlayerParams(_Params):
     #: with a Euclidean heuristic, margin 0, re-planned once per decision tick); ai/players.py
     safetygraph_goal: str = "escape"
 
+    from_world = ("guard_speed", "player_speed")
     bounds = {
         "maxmin_depth": Range(1, 6, integer=True),
         "maxmin_guards_advance": FLAG,
