@@ -36,7 +36,7 @@ from game.front.render import (
     init_pygame,
     pygame,
 )
-from game.front.keys import KEY_HELP, MODE_ORDER
+from game.front.keys import key_help, mode_order
 from navmesh.level import bundled_level_names
 from game.front.screens import Panel
 from game.front.sound import SoundBoard
@@ -51,7 +51,9 @@ from game.world import World
 
 
 #: Guard modes on the number keys, in the order of SPEC §9.
-MODE_KEYS: dict[int, str] = {pygame.K_1 + i: mode for i, mode in enumerate(MODE_ORDER)}
+def mode_keys() -> dict[int, str]:
+    """Number key -> guard mode: the registered modes in order (:func:`game.front.keys.mode_order`)."""
+    return {pygame.K_1 + i: mode for i, mode in enumerate(mode_order())}
 
 #: Stealth mechanics: the World method each input calls, and the label of its messages.
 MECHANICS: dict[str, tuple[Callable[..., Any], str]] = {
@@ -255,8 +257,8 @@ class PlayGame(FrameLoop):
 
     # ------------------------------------------------------------------ input
     def help_items(self) -> list[str]:
-        """The help line: every key of :data:`game.front.keys.KEY_HELP`, shortly."""
-        return [f"{keys} {what.split(' (')[0]}" for keys, what in KEY_HELP]
+        """The help line: every key of :func:`game.front.keys.key_help`, shortly."""
+        return [f"{keys} {what.split(' (')[0]}" for keys, what in key_help()]
 
     def _mechanic(self, method: str, *args: float) -> None:
         action, label = MECHANICS[method]
@@ -309,8 +311,8 @@ class PlayGame(FrameLoop):
             self.next_level()
         elif key == pygame.K_b:
             self.next_level(-1)
-        elif key in MODE_KEYS:
-            self.restart(MODE_KEYS[key])
+        elif key in (modes := mode_keys()):
+            self.restart(modes[key])
         elif key == pygame.K_e:
             self._mechanic("activate_decoy")
         elif key == pygame.K_f:
@@ -496,4 +498,4 @@ def _freeze_heap() -> None:
     gc.freeze()
 
 
-__all__ = ["MECHANICS", "MODE_KEYS", "PlayGame", "PlaySettings"]
+__all__ = ["MECHANICS", "PlayGame", "PlaySettings", "mode_keys"]
