@@ -68,6 +68,11 @@ class Registration(Generic[T]):
         return _resolve(self.params) if self.params is not None else None
 
 
+#: The guard mode and player policy a trial, ``stealth play`` and the environments take when
+#: none is named (the paper's method against its first scripted player).
+DEFAULT_GUARD_MODE = "pf"
+DEFAULT_PLAYER_POLICY = "maxmin"
+
 #: Registered guard modes by command-line name (SPEC §9 order: the order of play's keys).
 GUARD_MODES: dict[str, Registration[GuardAI]] = {}
 #: Registered player policies by command-line name.
@@ -182,7 +187,7 @@ register_player_policy("safetygraph", "ai.players:SafetyGraphPlayer", display="S
 register_player_policy("evade", "ai.players:EvadePlayer", display="Evade", short="EV")
 
 __all__ = [
-    "Event", "GuardAI", "Names", "PlayerPolicy", "Registration", "WorldView", "GUARD_MODES",
+    "DEFAULT_GUARD_MODE", "DEFAULT_PLAYER_POLICY", "Event", "GuardAI", "Names", "PlayerPolicy", "Registration", "WorldView", "GUARD_MODES",
     "PLAYER_POLICIES", "guard_mode", "make_guard_ai", "make_player_policy", "player_policy",
     "register_guard_mode", "register_player_policy", "unregister_guard_mode",
     "unregister_player_policy",

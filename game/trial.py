@@ -16,7 +16,7 @@ from typing import IO, Any
 
 import numpy as np
 
-from ai import guard_mode, player_policy
+from ai import DEFAULT_GUARD_MODE, DEFAULT_PLAYER_POLICY, guard_mode, player_policy
 from ai.stimuli import load_stimulus
 from ai.view import GuardAI, PlayerPolicy
 from navmesh.level import Level, cached_level
@@ -38,8 +38,8 @@ class TrialSpec:
 
     level: str
     abstraction: str = "grid"
-    guards: str = "pf"
-    player: str = "maxmin"
+    guards: str = DEFAULT_GUARD_MODE
+    player: str = DEFAULT_PLAYER_POLICY
     scenario: str = "capture"
     seed: int = 0
     overrides: tuple[tuple[str, Any], ...] = ()

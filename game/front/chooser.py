@@ -13,6 +13,8 @@ from collections.abc import Sequence
 import numpy as np
 import pygame
 
+from ai import DEFAULT_GUARD_MODE
+
 from .best import BestResults, describe
 from .keys import mode_order
 from .palette import BACKGROUND, BLOCKED, EXIT_EDGE, FLOOR, GOOD, GUARD, TEXT, TEXT_DIM, WARN, WALL
@@ -83,7 +85,7 @@ class LevelChooser:
     """Level cards in a window; :meth:`run` returns the chosen level name or None, and
     :attr:`mode` is the guard mode chosen with it."""
 
-    def __init__(self, screen: pygame.Surface, names: Sequence[str], mode: str = "pf",
+    def __init__(self, screen: pygame.Surface, names: Sequence[str], mode: str = DEFAULT_GUARD_MODE,
                  best: BestResults | None = None) -> None:
         self.screen, self.names, self.index = screen, list(names), 0
         self.mode = mode if mode in mode_order() else mode_order()[0]
