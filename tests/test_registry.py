@@ -141,9 +141,7 @@ def patrol() -> Iterator[str]:
 def test_a_registered_mode_brings_its_parameters_table_label_and_play_key(
         patrol: str, tmp_path: Path) -> None:
     from game.config import check_value
-    from game.front.keys import key_help, mode_order
-    from game.front.play import mode_keys
-    from game.front.render import pygame
+    from game.front.keys import key_help, mode_on_key, mode_order
     from game.schema import bound_of
     from headless.analysis.tables import GUARD_NAMES, GUARD_SHORT, table_rows, write_table
 
@@ -165,12 +163,12 @@ def test_a_registered_mode_brings_its_parameters_table_label_and_play_key(
     write_table(table_rows([{**row, **row["metrics"]}]), tmp_path, 1)
     assert "| Patrol | MaxMin |" in (tmp_path / "table.md").read_text(encoding="utf-8")
     # play: the next number key after the five built-ins
-    assert mode_order().index(patrol) == 5 and mode_keys()[pygame.K_6] == patrol
+    assert mode_order().index(patrol) == 5 and mode_on_key(6) == patrol
     assert ("1-6", "restart with guards pf/random/fsm/staleness/cheat/patrol") in key_help()
     unregister_guard_mode(patrol)  # and gone again: no key, no default, no play key
     with pytest.raises(ConfigError, match="patrol.speed: unknown config key"):
         check_value("patrol.speed", 1.0)
-    assert patrol not in mode_order() and patrol not in GUARD_NAMES
+    assert patrol not in mode_order() and mode_on_key(6) is None and patrol not in GUARD_NAMES
 
 
 def test_a_section_holds_one_parameter_class(patrol: str) -> None:

@@ -13,7 +13,7 @@ from __future__ import annotations
 
 from ai import GUARD_MODES
 
-__all__ = ["key_help", "key_table", "mode_order"]
+__all__ = ["key_help", "key_table", "mode_on_key", "mode_order"]
 
 #: number keys 1 … 9
 _NUMBER_KEYS = 9
@@ -22,6 +22,12 @@ _NUMBER_KEYS = 9
 def mode_order() -> tuple[str, ...]:
     """The guard modes on the number keys 1, 2, … (registration order, SPEC §9's first)."""
     return tuple(GUARD_MODES)[:_NUMBER_KEYS]
+
+
+def mode_on_key(number: int) -> str | None:
+    """The guard mode on number key ``number`` (1 … 9), or None when no mode is there."""
+    modes = mode_order()
+    return modes[number - 1] if 1 <= number <= len(modes) else None
 
 
 def key_help() -> tuple[tuple[str, str], ...]:

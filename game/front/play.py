@@ -36,7 +36,7 @@ from game.front.render import (
     init_pygame,
     pygame,
 )
-from game.front.keys import key_help, mode_order
+from game.front.keys import key_help, mode_on_key
 from navmesh.level import bundled_level_names
 from game.front.screens import Panel
 from game.front.sound import SoundBoard
@@ -49,11 +49,6 @@ from game.scene import OVERLAYS, Scene, SceneBuilder, overlay_key
 from game.trial import TrialSpec
 from game.world import World
 
-
-#: Guard modes on the number keys, in the order of SPEC §9.
-def mode_keys() -> dict[int, str]:
-    """Number key -> guard mode: the registered modes in order (:func:`game.front.keys.mode_order`)."""
-    return {pygame.K_1 + i: mode for i, mode in enumerate(mode_order())}
 
 #: Stealth mechanics: the World method each input calls, and the label of its messages.
 MECHANICS: dict[str, tuple[Callable[..., Any], str]] = {
@@ -311,8 +306,8 @@ class PlayGame(FrameLoop):
             self.next_level()
         elif key == pygame.K_b:
             self.next_level(-1)
-        elif key in (modes := mode_keys()):
-            self.restart(modes[key])
+        elif pygame.K_1 <= key <= pygame.K_9 and (mode := mode_on_key(key - pygame.K_0)):
+            self.restart(mode)
         elif key == pygame.K_e:
             self._mechanic("activate_decoy")
         elif key == pygame.K_f:
@@ -498,4 +493,4 @@ def _freeze_heap() -> None:
     gc.freeze()
 
 
-__all__ = ["MECHANICS", "PlayGame", "PlaySettings", "mode_keys"]
+__all__ = ["MECHANICS", "PlayGame", "PlaySettings"]
