@@ -21,10 +21,13 @@ from __future__ import annotations
 from collections.abc import Callable, Iterator, Mapping
 from dataclasses import dataclass
 from importlib import import_module
-from typing import Any, Generic, TypeVar
+from typing import TYPE_CHECKING, Any, Generic, TypeVar
 
 from .errors import UnknownNameError
 from .view import Event, GuardAI, PlayerPolicy, WorldView
+
+if TYPE_CHECKING:
+    from .params import _Params
 
 T = TypeVar("T", GuardAI, PlayerPolicy)
 
@@ -56,16 +59,21 @@ class Registration(Generic[T]):
     section: str
     short: str
     abbrev: str
-    params: type | str | None = None
+    params: type[_Params] | str | None = None
 
     def build(self, params: Mapping[str, Any] | None = None) -> T:
         """A fresh controller with ``params``."""
         factory: Callable[[Mapping[str, Any] | None], T] = _resolve(self.factory)
         return factory(params)
 
-    def parameters(self) -> type | None:
+    def parameters(self) -> type[_Params] | None:
         """The parameter dataclass (imported on first use), or None."""
         return _resolve(self.params) if self.params is not None else None
+
+
+def registrations() -> list[Registration[Any]]:
+    """Every registration: the guard modes', then the player policies'."""
+    return [*GUARD_MODES.values(), *PLAYER_POLICIES.values()]
 
 
 #: The guard mode and player policy a trial, ``stealth play`` and the environments take when
@@ -80,15 +88,16 @@ PLAYER_POLICIES: dict[str, Registration[PlayerPolicy]] = {}
 
 
 def _registration(name: str, factory: Any, display: str | None, short: str | None,
-                  abbrev: str | None, section: str, params: type | str | None) -> Registration[Any]:
+                  abbrev: str | None, section: str,
+                  params: type[_Params] | str | None) -> Registration[Any]:
     """A registration with its names filled in; refuses a section that another
     registration fills with another parameter class (one section, one set of keys)."""
-    for other in (*GUARD_MODES.values(), *PLAYER_POLICIES.values()):
-        if (other.name != name and other.section == section and other.params is not None
-                and params is not None and other.params != params
-                and other.parameters() is not _resolve(params)):
+    for other in registrations():
+        held = other.parameters() if other.params is not None else None
+        if (other.name != name and other.section == section and held is not None
+                and params is not None and other.params != params and held is not _resolve(params)):
             raise ValueError(f"{name}: config section [{section}] already holds the parameters "
-                             f"of {other.name!r} ({other.parameters().__name__})")  # type: ignore[union-attr]
+                             f"of {other.name!r} ({held.__name__})")
     display = display or name.title()
     short = short or display
     return Registration(name, factory, display, section, short, abbrev or short, params)
@@ -97,7 +106,7 @@ def _registration(name: str, factory: Any, display: str | None, short: str | Non
 def register_guard_mode(name: str, factory: Callable[..., GuardAI] | str, *,
                         display: str | None = None, short: str | None = None,
                         abbrev: str | None = None, section: str | None = None,
-                        params: type | str | None = None) -> None:
+                        params: type[_Params] | str | None = None) -> None:
     """Register guard mode ``name``: its parameters ``params`` in config section ``section``
     (default ``name``), its names (display default ``name.title()``, short default the
     display name). A mode registered later comes later (play's next number key).
@@ -108,7 +117,8 @@ def register_guard_mode(name: str, factory: Callable[..., GuardAI] | str, *,
 
 def register_player_policy(name: str, factory: Callable[..., PlayerPolicy] | str, *,
                            display: str | None = None, short: str | None = None,
-                           section: str = "player", params: type | str | None = None) -> None:
+                           section: str = "player",
+                           params: type[_Params] | str | None = None) -> None:
     """Register player policy ``name`` (its parameters ``params`` in config section ``section``)."""
     PLAYER_POLICIES[name] = _registration(name, factory, display, short, None, section, params)
 
@@ -187,8 +197,9 @@ register_player_policy("safetygraph", "ai.players:SafetyGraphPlayer", display="S
 register_player_policy("evade", "ai.players:EvadePlayer", display="Evade", short="EV")
 
 __all__ = [
-    "DEFAULT_GUARD_MODE", "DEFAULT_PLAYER_POLICY", "Event", "GuardAI", "Names", "PlayerPolicy", "Registration", "WorldView", "GUARD_MODES",
-    "PLAYER_POLICIES", "guard_mode", "make_guard_ai", "make_player_policy", "player_policy",
-    "register_guard_mode", "register_player_policy", "unregister_guard_mode",
+    "DEFAULT_GUARD_MODE", "DEFAULT_PLAYER_POLICY", "Event", "GuardAI", "Names", "PlayerPolicy",
+    "Registration", "WorldView", "GUARD_MODES", "PLAYER_POLICIES", "guard_mode",
+    "make_guard_ai", "make_player_policy", "player_policy", "register_guard_mode",
+    "register_player_policy", "registrations", "unregister_guard_mode",
     "unregister_player_policy",
 ]

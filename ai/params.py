@@ -40,6 +40,13 @@ class _Params:
     from_world: ClassVar[tuple[str, ...]] = ()
 
     @classmethod
+    def config_defaults(cls) -> dict[str, Any]:
+        """Field -> default of the fields that are config keys (all but :attr:`from_world`):
+        the one source of their section's defaults (``game.schema.parameter_defaults``)."""
+        return {f.name: f.default for f in fields(cls)  # type: ignore[arg-type]
+                if f.name not in cls.from_world}
+
+    @classmethod
     def from_mapping(cls: type[_P], params: Mapping[str, Any] | None = None) -> _P:
         """Defaults overridden by ``params``; an unknown key or a bad value raises ValueError."""
         known = [f.name for f in fields(cls)]  # type: ignore[arg-type]

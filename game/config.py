@@ -29,7 +29,8 @@ from typing import Any
 from ai.bounds import FLAG, Bound, Range
 from game.errors import ConfigError
 
-from .schema import bound_of, check_sections, parameter_defaults, parameter_sections, registered_params
+from .schema import (bound_of, check_sections, parameter_defaults, parameter_sections,
+                     registered_params)
 
 DEFAULTS_PATH = Path(__file__).with_name("defaults.toml")
 

@@ -9,9 +9,10 @@ defaults as defaults and its ``bounds`` (:mod:`ai.bounds`) as allowed values
 (:class:`~ai.stimuli.StimulusParams` plus :class:`~game.actions.ActionParams`) and the four
 switchable team rules. The keys no dataclass holds — ``[world]``, ``[scenario.*]``,
 ``[zones]`` (:class:`~ai.stimuli.Zone` per zone kind), ``[metrics]`` and the team rules'
-``enabled`` switches — have their defaults in ``game/defaults.toml`` and their bounds here. :func:`game.config.check_value` checks a value against
-:func:`bound_of` its key; :func:`check_sections` builds the dataclasses (their cross-key
-rules, e.g. ``w_I_max >= w_I_base``) and :func:`check_level` what depends on the level.
+``enabled`` switches — have their defaults in ``game/defaults.toml`` and their bounds here.
+:func:`game.config.check_value` checks a value against :func:`bound_of` its key;
+:func:`check_sections` builds the dataclasses (their cross-key rules, e.g.
+``w_I_max >= w_I_base``) and :func:`check_level` what depends on the level.
 ``docs/config.md`` is :func:`markdown_table` (a test keeps it current).
 
 >>> bound_of("pf.rho").describe(), bound_of("world.fov_deg").describe()
@@ -24,14 +25,13 @@ from __future__ import annotations
 
 import functools
 from collections.abc import Iterable, Mapping
-from dataclasses import fields
 from typing import TYPE_CHECKING, Any
 
-from ai import GUARD_MODES, PLAYER_POLICIES
+from ai import registrations
 from ai.bounds import COUNT, FLAG, NON_NEGATIVE, POSITIVE, Bound, OneOf, Range
 from ai.alert import AlertParams
 from ai.awareness import AwarenessParams
-from ai.params import PlayerParams
+from ai.params import PlayerParams, _Params
 from ai.radio import RadioParams
 from ai.roles import RoleParams
 from ai.stimuli import StimulusParams, Zone, zones_from_config
@@ -123,7 +123,7 @@ _TEAM_RULES: Mapping[str, Any] = {"awareness": AwarenessParams, "alert": AlertPa
                                   "radio": RadioParams, "roles": RoleParams}
 
 #: the world's parameter classes, by the section that holds their keys
-_WORLD_PARAMS: Mapping[str, tuple[type, ...]] = {
+_WORLD_PARAMS: Mapping[str, tuple[type[_Params], ...]] = {
     "stimuli": (StimulusParams, ActionParams), **{k: (v,) for k, v in _TEAM_RULES.items()}}
 
 #: the sections no parameter class holds (defaults in game/defaults.toml, bounds above)
@@ -133,18 +133,18 @@ _FILE_SECTIONS: Mapping[str, Mapping[str, Bound]] = {
     "metrics": METRICS,
 }
 
-_Registered = tuple[tuple[str, str, type], ...]
+_Registered = tuple[tuple[str, str, type[_Params]], ...]
 
 
 def registered_params() -> _Registered:
     """``(section, name, params class)`` of every registration that has parameters."""
-    return tuple((r.section, r.name, cls) for r in (*GUARD_MODES.values(), *PLAYER_POLICIES.values())
+    return tuple((r.section, r.name, cls) for r in registrations()
                  if (cls := r.parameters()) is not None)
 
 
 @functools.cache
-def _sections(registered: _Registered) -> dict[str, tuple[type, ...]]:
-    sections: dict[str, tuple[type, ...]] = {}
+def _sections(registered: _Registered) -> dict[str, tuple[type[_Params], ...]]:
+    sections: dict[str, tuple[type[_Params], ...]] = {}
     for section, name, cls in registered:
         if section in _FILE_SECTIONS or section in _WORLD_PARAMS or section.startswith("scenario"):
             raise ConfigError(f"{name}: config section [{section}] is the world's; register "
@@ -153,7 +153,7 @@ def _sections(registered: _Registered) -> dict[str, tuple[type, ...]]:
     return {**sections, **_WORLD_PARAMS}
 
 
-def parameter_sections() -> Mapping[str, tuple[type, ...]]:
+def parameter_sections() -> Mapping[str, tuple[type[_Params], ...]]:
     """Config section -> the parameter dataclasses whose fields are its keys: the registered
     guard modes' and player policies' (registration order), then the world's.
 
@@ -161,11 +161,6 @@ def parameter_sections() -> Mapping[str, tuple[type, ...]]:
     (['StimulusParams', 'ActionParams'], (<class 'ai.params.PFParams'>,))
     """
     return _sections(registered_params())
-
-
-def _keys(cls: type) -> list[str]:
-    """The fields of ``cls`` that are config keys (not those the trial fills from [world])."""
-    return [f.name for f in fields(cls) if f.name not in cls.from_world]
 
 
 def parameter_defaults(section: str) -> dict[str, Any]:
@@ -176,7 +171,7 @@ def parameter_defaults(section: str) -> dict[str, Any]:
     (0.95, False)
     """
     classes = parameter_sections().get(section, ())
-    return {f.name: f.default for cls in classes for f in fields(cls) if f.name in _keys(cls)}
+    return {k: v for cls in classes for k, v in cls.config_defaults().items()}
 
 
 @functools.cache
@@ -185,7 +180,7 @@ def _tables(registered: _Registered) -> dict[str, Mapping[str, Bound]]:
     for section, classes in _sections(registered).items():
         table: dict[str, Bound] = {"enabled": FLAG} if section in _TEAM_RULES else {}
         for cls in classes:
-            table.update({k: cls.bounds[k] for k in _keys(cls)})
+            table.update({k: cls.bounds[k] for k in cls.config_defaults()})
         tables[section] = table
     return tables
 
@@ -193,7 +188,8 @@ def _tables(registered: _Registered) -> dict[str, Mapping[str, Bound]]:
 def bound_of(key: str) -> Bound:
     """The declared allowed values of config key ``key``; KeyError when none is declared."""
     section, _, name = key.rpartition(".")
-    table = SCENARIO if section.startswith("scenario.") else _tables(registered_params()).get(section, {})
+    tables = _tables(registered_params())
+    table = SCENARIO if section.startswith("scenario.") else tables.get(section, {})
     if name not in table:
         raise KeyError(f"{key}: no bound declared in game.schema")
     return table[name]
@@ -224,7 +220,7 @@ def check_sections(values: Mapping[str, Any]) -> None:
     for section, classes in parameter_sections().items():
         given = _section(values, section)
         for cls in classes:
-            own = {k: given[k] for k in _keys(cls) if k in given}
+            own = {k: given[k] for k in cls.config_defaults() if k in given}
             if not cls.from_world:
                 builds.append((section, cls, own))
             builds += [(f"{section} (scenario {scenario})", cls,
