@@ -20,6 +20,7 @@ from __future__ import annotations
 
 from collections.abc import Callable, Iterator, Mapping
 from dataclasses import dataclass
+from functools import cached_property
 from importlib import import_module
 from typing import TYPE_CHECKING, Any, Generic, TypeVar
 
@@ -68,6 +69,10 @@ class Registration(Generic[T]):
 
     def parameters(self) -> type[_Params] | None:
         """The parameter dataclass (imported on first use), or None."""
+        return self._parameters
+
+    @cached_property
+    def _parameters(self) -> type[_Params] | None:
         return _resolve(self.params) if self.params is not None else None
 
 
