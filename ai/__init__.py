@@ -1,69 +1,131 @@
 """Guard AI and player policies: composite potential fields, baselines, stimuli.
 
 Imports ``navmesh`` only (SPEC §1). Guard modes and player policies are **registered** here
-by name — with a display name and the config section their parameters come from — so the
-world, the CLI and the sweep never import a concrete controller class, and a new mode is
-one :func:`register_guard_mode` call in the module that defines it (or in a test):
+by name, and a registration carries everything the rest of the house needs: how to build
+the controller, its parameter dataclass and the config section those parameters live in
+(the config's keys and defaults, ``game.schema``), its display and short names (Table 3,
+figures, robustness), and its place (the number keys of ``stealth play``). The world, the
+CLI, the sweep and the reports never import a concrete controller class or write a mode's
+name again, so a new mode is one :func:`register_guard_mode` call in the module that
+defines it (or in a test):
 
 >>> from ai.baselines import RandomWalkGuards
->>> register_guard_mode("random2", RandomWalkGuards, display="RandomWalk (copy)")
->>> make_guard_ai("random2").mode, GUARD_MODES["random2"].section
-('random', 'random2')
+>>> register_guard_mode("random2", RandomWalkGuards, display="RandomWalk (copy)", short="R2")
+>>> make_guard_ai("random2").mode, GUARD_MODES["random2"].section, GUARD_MODES["random2"].short
+('random', 'random2', 'R2')
 >>> unregister_guard_mode("random2")
 """
 
 from __future__ import annotations
 
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Iterator, Mapping
 from dataclasses import dataclass
+from functools import cached_property
 from importlib import import_module
-from typing import Any, Generic, TypeVar
+from typing import TYPE_CHECKING, Any, Generic, TypeVar
 
 from .errors import UnknownNameError
 from .view import Event, GuardAI, PlayerPolicy, WorldView
 
+if TYPE_CHECKING:
+    from .params import _Params
+
 T = TypeVar("T", GuardAI, PlayerPolicy)
+
+
+def _resolve(ref: Any) -> Any:
+    """``ref`` itself, or the object a lazy ``"module:attr"`` reference names."""
+    if isinstance(ref, str):
+        module, _, attr = ref.partition(":")
+        return getattr(import_module(module), attr)
+    return ref
 
 
 @dataclass(frozen=True)
 class Registration(Generic[T]):
-    """One registered controller: how to build it and how to name it.
+    """One registered controller: how to build it, what it is tuned by, how it is named.
 
     ``factory`` is a class (or any callable taking the params mapping) or a lazy
-    ``"module:attr"`` reference, imported the first time the name is built. ``display`` is
-    the name tables and figures print; ``section`` the config table its params come from.
+    ``"module:attr"`` reference, imported the first time the name is built. ``params`` is
+    its parameter dataclass (an :class:`ai.params._Params`, or a ``"module:attr"``
+    reference; ``None``: it takes none): its fields are the config keys of ``section``,
+    their defaults the config's defaults, its ``bounds`` their allowed values. ``display``
+    is the name tables and figures print, ``short`` the figures' tick label and ``abbrev``
+    the name in dense text (the robustness verdicts; default ``short``).
     """
 
     name: str
     factory: Callable[[Mapping[str, Any] | None], T] | str
     display: str
     section: str
+    short: str
+    abbrev: str
+    params: type[_Params] | str | None = None
 
     def build(self, params: Mapping[str, Any] | None = None) -> T:
         """A fresh controller with ``params``."""
-        factory = self.factory
-        if isinstance(factory, str):
-            module, _, attr = factory.partition(":")
-            factory = getattr(import_module(module), attr)
+        factory: Callable[[Mapping[str, Any] | None], T] = _resolve(self.factory)
         return factory(params)
 
+    def parameters(self) -> type[_Params] | None:
+        """The parameter dataclass (imported on first use), or None."""
+        return self._parameters
 
-#: Registered guard modes by command-line name (SPEC §9 order).
+    @cached_property
+    def _parameters(self) -> type[_Params] | None:
+        return _resolve(self.params) if self.params is not None else None
+
+
+def registrations() -> list[Registration[Any]]:
+    """Every registration: the guard modes', then the player policies'."""
+    return [*GUARD_MODES.values(), *PLAYER_POLICIES.values()]
+
+
+#: The guard mode and player policy a trial, ``stealth play`` and the environments take when
+#: none is named (the paper's method against its first scripted player).
+DEFAULT_GUARD_MODE = "pf"
+DEFAULT_PLAYER_POLICY = "maxmin"
+
+#: Registered guard modes by command-line name (SPEC §9 order: the order of play's keys).
 GUARD_MODES: dict[str, Registration[GuardAI]] = {}
 #: Registered player policies by command-line name.
 PLAYER_POLICIES: dict[str, Registration[PlayerPolicy]] = {}
 
 
+def _registration(name: str, factory: Any, display: str | None, short: str | None,
+                  abbrev: str | None, section: str,
+                  params: type[_Params] | str | None) -> Registration[Any]:
+    """A registration with its names filled in; refuses a section that another
+    registration fills with another parameter class (one section, one set of keys)."""
+    for other in registrations():
+        held = other.parameters() if other.params is not None else None
+        if (other.name != name and other.section == section and held is not None
+                and params is not None and other.params != params and held is not _resolve(params)):
+            raise ValueError(f"{name}: config section [{section}] already holds the parameters "
+                             f"of {other.name!r} ({held.__name__})")
+    display = display or name.title()
+    short = short or display
+    return Registration(name, factory, display, section, short, abbrev or short, params)
+
+
 def register_guard_mode(name: str, factory: Callable[..., GuardAI] | str, *,
-                        display: str | None = None, section: str | None = None) -> None:
-    """Register guard mode ``name`` (config section ``section``, default ``name``)."""
-    GUARD_MODES[name] = Registration(name, factory, display or name, section or name)
+                        display: str | None = None, short: str | None = None,
+                        abbrev: str | None = None, section: str | None = None,
+                        params: type[_Params] | str | None = None) -> None:
+    """Register guard mode ``name``: its parameters ``params`` in config section ``section``
+    (default ``name``), its names (display default ``name.title()``, short default the
+    display name). A mode registered later comes later (play's next number key).
+    """
+    GUARD_MODES[name] = _registration(name, factory, display, short, abbrev, section or name,
+                                      params)
 
 
 def register_player_policy(name: str, factory: Callable[..., PlayerPolicy] | str, *,
-                           display: str | None = None, section: str = "player") -> None:
-    """Register player policy ``name`` (its params come from config section ``section``)."""
-    PLAYER_POLICIES[name] = Registration(name, factory, display or name, section)
+                           display: str | None = None, short: str | None = None,
+                           section: str = "player",
+                           params: type[_Params] | str | None = None) -> None:
+    """Register player policy ``name`` (its parameters ``params`` in config section ``section``)."""
+    PLAYER_POLICIES[name] = _registration(name, factory, display, short, None, section, params)
 
 
 def unregister_guard_mode(name: str) -> None:
@@ -74,6 +136,27 @@ def unregister_guard_mode(name: str) -> None:
 def unregister_player_policy(name: str) -> None:
     """Remove a player policy registered by :func:`register_player_policy`."""
     PLAYER_POLICIES.pop(name, None)
+
+
+class Names(Mapping[str, str]):
+    """One name of every registration in ``table`` (``"display"``, ``"short"``, ``"abbrev"``),
+    read live, so a mode registered later has its names in every report.
+
+    >>> Names(GUARD_MODES, "display")["pf"], "nobody" in Names(GUARD_MODES, "short")
+    ('PotentialField', False)
+    """
+
+    def __init__(self, table: Mapping[str, Registration[Any]], attr: str) -> None:
+        self._table, self._attr = table, attr
+
+    def __getitem__(self, name: str) -> str:
+        return str(getattr(self._table[name], self._attr))
+
+    def __iter__(self) -> Iterator[str]:
+        return iter(list(self._table))
+
+    def __len__(self) -> int:
+        return len(self._table)
 
 
 def _lookup(table: Mapping[str, Registration[T]], name: str, what: str) -> Registration[T]:
@@ -104,18 +187,24 @@ def make_player_policy(policy: str, params: Mapping[str, Any] | None = None) -> 
     return player_policy(policy).build(params)
 
 
-register_guard_mode("pf", "ai.pf:PotentialFieldGuards", display="PotentialField")
-register_guard_mode("random", "ai.baselines:RandomWalkGuards", display="RandomWalk")
-register_guard_mode("fsm", "ai.baselines:FSMGuards", display="FSM")
-register_guard_mode("staleness", "ai.baselines:StalenessGuards", display="Staleness")
-register_guard_mode("cheat", "ai.baselines:CheatGuards", display="Cheat")
-register_player_policy("maxmin", "ai.players:MaxMinPlayer", display="MaxMin")
-register_player_policy("safetygraph", "ai.players:SafetyGraphPlayer", display="SafetyGraph")
-register_player_policy("evade", "ai.players:EvadePlayer", display="Evade")
+register_guard_mode("pf", "ai.pf:PotentialFieldGuards", display="PotentialField", short="PF",
+                    params="ai.params:PFParams")
+register_guard_mode("random", "ai.baselines:RandomWalkGuards", display="RandomWalk", short="RW")
+register_guard_mode("fsm", "ai.baselines:FSMGuards", display="FSM", params="ai.params:FSMParams")
+register_guard_mode("staleness", "ai.baselines:StalenessGuards", display="Staleness", short="S",
+                    abbrev="Stal", params="ai.params:StalenessParams")
+register_guard_mode("cheat", "ai.baselines:CheatGuards", display="Cheat", short="C",
+                    abbrev="Cheat")
+register_player_policy("maxmin", "ai.players:MaxMinPlayer", display="MaxMin", short="MM",
+                       params="ai.params:PlayerParams")
+register_player_policy("safetygraph", "ai.players:SafetyGraphPlayer", display="SafetyGraph",
+                       short="SG", params="ai.params:PlayerParams")
+register_player_policy("evade", "ai.players:EvadePlayer", display="Evade", short="EV")
 
 __all__ = [
-    "Event", "GuardAI", "PlayerPolicy", "Registration", "WorldView", "GUARD_MODES",
-    "PLAYER_POLICIES", "guard_mode", "make_guard_ai", "make_player_policy", "player_policy",
-    "register_guard_mode", "register_player_policy", "unregister_guard_mode",
+    "DEFAULT_GUARD_MODE", "DEFAULT_PLAYER_POLICY", "Event", "GuardAI", "Names", "PlayerPolicy",
+    "Registration", "WorldView", "GUARD_MODES", "PLAYER_POLICIES", "guard_mode",
+    "make_guard_ai", "make_player_policy", "player_policy", "register_guard_mode",
+    "register_player_policy", "registrations", "unregister_guard_mode",
     "unregister_player_policy",
 ]

@@ -22,11 +22,15 @@ from __future__ import annotations
 
 from collections.abc import Mapping
 from dataclasses import dataclass, fields
+from types import MappingProxyType
 from typing import Any, ClassVar, TypeVar
 
 from .bounds import ANY_NUMBER, COUNT, FLAG, FRACTION, NON_NEGATIVE, POSITIVE, UNIT, Bound, OneOf, Range
 
 _P = TypeVar("_P", bound="_Params")
+
+#: per parameter class, its config keys' defaults (:meth:`_Params.config_defaults`)
+_CONFIG_DEFAULTS: dict[type, Mapping[str, Any]] = {}
 
 
 class _Params:
@@ -35,6 +39,19 @@ class _Params:
     #: field name -> its allowed values (:mod:`ai.bounds`), one declaration per field; the
     #: config schema (``game.schema``) reads these for the keys of the section
     bounds: ClassVar[Mapping[str, Bound]] = {}
+    #: fields the trial fills in from ``[world]`` and the scenario (``game.trial.player_params``),
+    #: so they are no config keys of the class's own section
+    from_world: ClassVar[tuple[str, ...]] = ()
+
+    @classmethod
+    def config_defaults(cls) -> Mapping[str, Any]:
+        """Field -> default of the fields that are config keys (all but :attr:`from_world`):
+        the one source of their section's defaults (``game.schema.parameter_defaults``)."""
+        if cls not in _CONFIG_DEFAULTS:
+            _CONFIG_DEFAULTS[cls] = MappingProxyType({
+                f.name: f.default for f in fields(cls)  # type: ignore[arg-type]
+                if f.name not in cls.from_world})
+        return _CONFIG_DEFAULTS[cls]
 
     @classmethod
     def from_mapping(cls: type[_P], params: Mapping[str, Any] | None = None) -> _P:
@@ -193,6 +210,7 @@ class PlayerParams(_Params):
     #: with a Euclidean heuristic, margin 0, re-planned once per decision tick); ai/players.py
     safetygraph_goal: str = "escape"
 
+    from_world = ("guard_speed", "player_speed")
     bounds = {
         "maxmin_depth": Range(1, 6, integer=True),
         "maxmin_guards_advance": FLAG,

@@ -1,4 +1,11 @@
-"""Trial configuration: one TOML file of documented defaults plus ``key=value`` overrides.
+"""Trial configuration: documented defaults plus ``key=value`` overrides.
+
+Every default is written once: a key of a parameter dataclass (a registered guard mode's
+or player policy's, the stimuli's, the team rules') has its field default
+(:func:`game.schema.parameter_defaults`); the keys no dataclass holds — ``[world]``,
+``[scenario.*]``, ``[zones]``, ``[metrics]``, the ``enabled`` switches — are in
+``game/defaults.toml``, whose empty tables say where a section's parameters come from and
+so where its keys stand in the config.
 
 Keys are dotted paths into the TOML tables (``world.view_range``, ``pf.rho``,
 ``scenario.capture.view_range_scale``). An override must name an existing key, is
@@ -22,7 +29,8 @@ from typing import Any
 from ai.bounds import FLAG, Bound, Range
 from game.errors import ConfigError
 
-from .schema import bound_of, check_sections
+from .schema import (bound_of, check_sections, parameter_defaults, parameter_sections,
+                     registered_params)
 
 DEFAULTS_PATH = Path(__file__).with_name("defaults.toml")
 
@@ -43,9 +51,28 @@ def _flatten(table: Mapping[str, Any], prefix: str = "") -> dict[str, Any]:
 
 
 @functools.cache
-def _default_values() -> dict[str, Any]:
+def _file_tables() -> dict[str, Any]:
     with DEFAULTS_PATH.open("rb") as handle:
-        return _flatten(tomllib.load(handle))
+        return tomllib.load(handle)
+
+
+@functools.cache
+def _defaults(registered: Any) -> dict[str, Any]:
+    """The file's values with every parameter section's defaults at its table's place
+    (sections the file does not name, a registered mode's, at the end)."""
+    tables = _file_tables()
+    values: dict[str, Any] = {}
+    for name in [*tables, *(s for s in parameter_sections() if s not in tables)]:
+        table = tables.get(name, {})
+        values.update(_flatten(table, name + "."))
+        values.update({f"{name}.{k}": v for k, v in parameter_defaults(name).items()})
+    return values
+
+
+def _default_values() -> dict[str, Any]:
+    """Every config key's default (read-only: shared), for the guard modes and player
+    policies registered now."""
+    return _defaults(registered_params())
 
 
 _WORDS = {"true": True, "1": True, "yes": True, "false": False, "0": False, "no": False}

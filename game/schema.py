@@ -1,13 +1,18 @@
-"""The allowed values of every config key (``game/defaults.toml``), declared once each.
+"""The config's keys, their defaults' one source and their allowed values, declared once each.
 
-A section that feeds a parameter dataclass takes that class's ``bounds``
-(:mod:`ai.bounds`): ``[pf]`` is :class:`~ai.params.PFParams`, ``[fsm]`` / ``[staleness]``
-the FSM classes, ``[player]`` :class:`~ai.params.PlayerParams`, ``[stimuli]``
-:class:`~ai.stimuli.StimulusParams` plus :class:`~game.action_params.ActionParams`, ``[zones]``
-:class:`~ai.stimuli.Zone` per zone kind. The world's and the scenarios' keys, which no
-dataclass holds, are declared here. :func:`game.config.check_value` checks a value against
-:func:`bound_of` its key; :func:`check_sections` builds the dataclasses (their cross-key
-rules, e.g. ``w_I_max >= w_I_base``) and :func:`check_level` what depends on the level.
+A section that feeds a parameter dataclass has that class's fields as keys, its field
+defaults as defaults and its ``bounds`` (:mod:`ai.bounds`) as allowed values
+(:func:`parameter_sections`): each registered guard mode and player policy brings its own
+(``ai.register_guard_mode(..., params=, section=)``: ``[pf]`` is
+:class:`~ai.params.PFParams`, ``[fsm]`` / ``[staleness]`` the FSM classes, ``[player]``
+:class:`~ai.params.PlayerParams`), and the world's are ``[stimuli]``
+(:class:`~ai.stimuli.StimulusParams` plus :class:`~game.action_params.ActionParams`) and the four
+switchable team rules. The keys no dataclass holds — ``[world]``, ``[scenario.*]``,
+``[zones]`` (:class:`~ai.stimuli.Zone` per zone kind), ``[metrics]`` and the team rules'
+``enabled`` switches — have their defaults in ``game/defaults.toml`` and their bounds here.
+:func:`game.config.check_value` checks a value against :func:`bound_of` its key;
+:func:`check_sections` builds the dataclasses (their cross-key rules, e.g.
+``w_I_max >= w_I_base``) and :func:`check_level` what depends on the level.
 ``docs/config.md`` is :func:`markdown_table` (a test keeps it current).
 
 >>> bound_of("pf.rho").describe(), bound_of("world.fov_deg").describe()
@@ -18,13 +23,15 @@ True
 
 from __future__ import annotations
 
+import functools
 from collections.abc import Iterable, Mapping
 from typing import TYPE_CHECKING, Any, Protocol
 
+from ai import registrations
 from ai.bounds import COUNT, FLAG, NON_NEGATIVE, POSITIVE, Bound, OneOf, Range
 from ai.alert import AlertParams
 from ai.awareness import AwarenessParams
-from ai.params import FSMParams, PFParams, PlayerParams, StalenessParams
+from ai.params import PlayerParams, _Params
 from ai.radio import RadioParams
 from ai.roles import RoleParams
 from ai.stimuli import StimulusParams, Zone, zones_from_config
@@ -40,7 +47,9 @@ if TYPE_CHECKING:
     from navmesh.level import Level
 
 __all__ = [
-    "RESPAWN_RULES", "SEED", "SPAWN_RULES", "bound_of", "check_level", "check_sections", "markdown_table",
+    "RESPAWN_RULES", "SEED", "SPAWN_RULES", "bound_of", "check_level", "check_sections",
+    "markdown_table", "parameter_defaults", "parameter_sections", "registered_params",
+    "scenario_speeds",
 ]
 
 SPAWN_RULES = ("random", "level")
@@ -106,34 +115,90 @@ METRICS: Mapping[str, Bound] = {
 }
 """``[metrics]``: the definition of coverage, backtracks and distance."""
 
-_PLAYER_OWN = {k: v for k, v in PlayerParams.bounds.items()
-               if k not in ("guard_speed", "player_speed")}  # those come from [world]
-
-#: the switchable rules beyond the paper: config section -> parameter class
+#: the switchable rules beyond the paper: config section -> parameter class; each section
+#: also has an ``enabled`` switch (game.team)
 _TEAM_RULES: Mapping[str, Any] = {"awareness": AwarenessParams, "alert": AlertParams,
                                   "radio": RadioParams, "roles": RoleParams}
 
-_SECTIONS: Mapping[str, Mapping[str, Bound]] = {
+#: the world's parameter classes, by the section that holds their keys
+_WORLD_PARAMS: Mapping[str, tuple[type[_Params], ...]] = {
+    "stimuli": (StimulusParams, ActionParams), **{k: (v,) for k, v in _TEAM_RULES.items()}}
+
+#: the sections no parameter class holds (defaults in game/defaults.toml, bounds above)
+_FILE_SECTIONS: Mapping[str, Mapping[str, Bound]] = {
     "world": WORLD,
     "zones": {f"{kind}_{name}": bound for kind in ZONE_KINDS for name, bound in Zone.bounds.items()},
-    "stimuli": {**StimulusParams.bounds, **ActionParams.bounds},
-    "pf": PFParams.bounds,
-    "fsm": FSMParams.bounds,
-    "staleness": StalenessParams.bounds,
-    "player": _PLAYER_OWN,
-    # beyond the paper (docs/ai.md): each section's switch plus its parameter class
-    **{name: {"enabled": FLAG, **cls.bounds} for name, cls in _TEAM_RULES.items()},
     "metrics": METRICS,
 }
+
+_Registered = tuple[tuple[str, str, type[_Params]], ...]
+
+
+def registered_params() -> _Registered:
+    """``(section, name, params class)`` of every registration that has parameters."""
+    return tuple((r.section, r.name, cls) for r in registrations()
+                 if (cls := r.parameters()) is not None)
+
+
+@functools.cache
+def _sections(registered: _Registered) -> dict[str, tuple[type[_Params], ...]]:
+    sections: dict[str, tuple[type[_Params], ...]] = {}
+    for section, name, cls in registered:
+        if section in _FILE_SECTIONS or section in _WORLD_PARAMS or section.startswith("scenario"):
+            raise ConfigError(f"{name}: config section [{section}] is the world's; register "
+                              "its parameters under a section of their own")
+        sections.setdefault(section, (cls,))  # one class a section: ai checks at registration
+    return {**sections, **_WORLD_PARAMS}
+
+
+def parameter_sections() -> Mapping[str, tuple[type[_Params], ...]]:
+    """Config section -> the parameter dataclasses whose fields are its keys: the registered
+    guard modes' and player policies' (registration order), then the world's.
+
+    >>> [c.__name__ for c in parameter_sections()["stimuli"]], parameter_sections()["pf"]
+    (['StimulusParams', 'ActionParams'], (<class 'ai.params.PFParams'>,))
+    """
+    return _sections(registered_params())
+
+
+def parameter_defaults(section: str) -> dict[str, Any]:
+    """The defaults of ``section``'s keys, from its parameter classes (the one source);
+    empty for a section no parameter class holds.
+
+    >>> parameter_defaults("pf")["rho"], "guard_speed" in parameter_defaults("player")
+    (0.95, False)
+    """
+    classes = parameter_sections().get(section, ())
+    return {k: v for cls in classes for k, v in cls.config_defaults().items()}
+
+
+@functools.cache
+def _tables(registered: _Registered) -> dict[str, Mapping[str, Bound]]:
+    tables: dict[str, Mapping[str, Bound]] = dict(_FILE_SECTIONS)
+    for section, classes in _sections(registered).items():
+        table: dict[str, Bound] = {"enabled": FLAG} if section in _TEAM_RULES else {}
+        for cls in classes:
+            table.update({k: cls.bounds[k] for k in cls.config_defaults()})
+        tables[section] = table
+    return tables
 
 
 def bound_of(key: str) -> Bound:
     """The declared allowed values of config key ``key``; KeyError when none is declared."""
     section, _, name = key.rpartition(".")
-    table = SCENARIO if section.startswith("scenario.") else _SECTIONS.get(section, {})
+    tables = _tables(registered_params())
+    table = SCENARIO if section.startswith("scenario.") else tables.get(section, {})
     if name not in table:
         raise KeyError(f"{key}: no bound declared in game.schema")
     return table[name]
+
+
+def scenario_speeds(values: Any, scenario: str) -> dict[str, float]:
+    """The speeds a player policy's parameters take from ``[world]`` in ``scenario``
+    (``PlayerParams.from_world``); ``values`` is a config or its flat mapping."""
+    return {"guard_speed": values["world.guard_speed"],
+            "player_speed": (values["world.player_speed"]
+                             * values[f"scenario.{scenario}.player_speed_scale"])}
 
 
 def _section(values: Mapping[str, Any], name: str) -> dict[str, Any]:
@@ -148,24 +213,17 @@ def check_sections(values: Mapping[str, Any]) -> None:
 
     ``values`` are already in range key by key (:func:`game.config.check_value`).
     """
-    builds: list[tuple[str, Any, dict[str, Any]]] = [
-        ("pf", PFParams, _section(values, "pf")),
-        ("fsm", FSMParams, _section(values, "fsm")),
-        ("staleness", StalenessParams, _section(values, "staleness")),
-    ]
-    builds += [(name, cls, {k: v for k, v in _section(values, name).items() if k != "enabled"})
-               for name, cls in _TEAM_RULES.items()]
-    stimuli = _section(values, "stimuli")
-    actions = {k: v for k, v in stimuli.items() if k in ActionParams.bounds}
-    builds.append(("stimuli", ActionParams, actions))
-    builds.append(("stimuli", StimulusParams,
-                   {k: v for k, v in stimuli.items() if k not in actions}))
-    for scenario in sorted({k.split(".")[1] for k in values if k.startswith("scenario.")}):
-        player = _section(values, "player")
-        player["guard_speed"] = values["world.guard_speed"]
-        player["player_speed"] = (values["world.player_speed"]
-                                  * values[f"scenario.{scenario}.player_speed_scale"])
-        builds.append((f"player (scenario {scenario})", PlayerParams, player))
+    scenarios = sorted({k.split(".")[1] for k in values if k.startswith("scenario.")})
+    builds: list[tuple[str, Any, dict[str, Any]]] = []
+    for section, classes in parameter_sections().items():
+        given = _section(values, section)
+        for cls in classes:
+            own = {k: given[k] for k in cls.config_defaults() if k in given}
+            if not cls.from_world:
+                builds.append((section, cls, own))
+            builds += [(f"{section} (scenario {scenario})", cls,
+                        {**own, **scenario_speeds(values, scenario)})
+                       for scenario in (scenarios if cls.from_world else ())]
     for where, cls, params in builds:
         try:
             cls.from_mapping(params)
@@ -201,10 +259,18 @@ def check_level(config: Settings, level: Level) -> None:
     check_body(level, radius)  # and reach the whole walkable area: validate's check too
 
 
-def markdown_table(keys: Iterable[str]) -> str:
-    """The allowed values of ``keys`` as a Markdown table (``docs/config.md``)."""
-    lines = ["| key | allowed values |", "|---|---|"]
-    for key in keys:
+def _toml(value: Any) -> str:
+    """A default as a config file writes it."""
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    return f'"{value}"' if isinstance(value, str) else repr(value)
+
+
+def markdown_table(defaults: Mapping[str, Any]) -> str:
+    """Every key of ``defaults`` with its default and its allowed values, as a Markdown
+    table (``docs/config.md``: with the defaults' one source in code, the doc lists them)."""
+    lines = ["| key | default | allowed values |", "|---|---|---|"]
+    for key, default in defaults.items():
         bound = bound_of(key)
         if isinstance(bound, Range):
             text = ("whole number in " if bound.integer else "") + bound.describe()
@@ -212,5 +278,5 @@ def markdown_table(keys: Iterable[str]) -> str:
             text = "one of " + bound.describe()
         if key == "world.agent_radius":
             text += ", and below half the level's cell size"
-        lines.append(f"| `{key}` | {text} |")
+        lines.append(f"| `{key}` | `{_toml(default)}` | {text} |")
     return "\n".join(lines) + "\n"

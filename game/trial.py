@@ -16,12 +16,13 @@ from typing import IO, Any
 
 import numpy as np
 
-from ai import make_guard_ai, make_player_policy
+from ai import DEFAULT_GUARD_MODE, DEFAULT_PLAYER_POLICY, guard_mode, player_policy
 from ai.stimuli import load_stimulus
 from ai.view import GuardAI, PlayerPolicy
 from navmesh.level import Level, cached_level
 
 from .config import Config
+from .schema import scenario_speeds
 from .trace import attach_trace
 from .world import Generators, World
 
@@ -37,8 +38,8 @@ class TrialSpec:
 
     level: str
     abstraction: str = "grid"
-    guards: str = "pf"
-    player: str = "maxmin"
+    guards: str = DEFAULT_GUARD_MODE
+    player: str = DEFAULT_PLAYER_POLICY
     scenario: str = "capture"
     seed: int = 0
     overrides: tuple[tuple[str, Any], ...] = ()
@@ -106,8 +107,10 @@ def make_world(
     if level is None:
         level = cached_level(spec.level)
     if controllers is None:
-        controllers = (make_guard_ai(spec.guards, config.section(spec.guards)),
-                       make_player_policy(spec.player, player_params(config, spec.scenario)))
+        guards = guard_mode(spec.guards)
+        controllers = (guards.build(config.section(guards.section)),
+                       player_policy(spec.player).build(
+                           player_params(config, spec.scenario, spec.player)))
     guard_ai, player = controllers
     return World(
         level,
@@ -139,14 +142,11 @@ def identity_row(spec: TrialSpec, level_name: str | None = None, *,
     }
 
 
-def player_params(config: Config, scenario: str) -> dict[str, Any]:
-    """What a player policy needs: its own section plus both speeds in this scenario."""
-    params = config.section("player")
-    params["guard_speed"] = config["world.guard_speed"]
-    params["player_speed"] = (
-        config["world.player_speed"] * config[f"scenario.{scenario}.player_speed_scale"]
-    )
-    return params
+def player_params(config: Config, scenario: str, policy: str | None = None) -> dict[str, Any]:
+    """What a player policy needs: its own section (``policy``'s registered one; the
+    built-ins' ``[player]`` when not given) plus both speeds in this scenario."""
+    section = "player" if policy is None else player_policy(policy).section
+    return {**config.section(section), **scenario_speeds(config, scenario)}
 
 
 def run_trial(

@@ -18,6 +18,7 @@ from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
+from ai import DEFAULT_GUARD_MODE, DEFAULT_PLAYER_POLICY
 from game.trial import TrialSpec, make_world, run_trial
 from game.world import World
 
@@ -28,8 +29,9 @@ from .store import IDENTITY, STORE_NAME, ResultStore
 __all__ = ["as_rows", "build_world", "load_store", "run_design", "run_one", "trial_spec"]
 
 
-def trial_spec(level: str, *, abstraction: str = "grid", guards: str = "pf",
-               player: str = "maxmin", scenario: str = "capture", seed: int = 0,
+def trial_spec(level: str, *, abstraction: str = "grid",
+               guards: str = DEFAULT_GUARD_MODE, player: str = DEFAULT_PLAYER_POLICY,
+               scenario: str = "capture", seed: int = 0,
                overrides: Mapping[str, Any] | None = None,
                stimuli: Sequence[str] = ()) -> TrialSpec:
     """The :class:`~game.trial.TrialSpec` of these settings (``overrides``: config keys)."""

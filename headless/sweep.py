@@ -134,7 +134,7 @@ def _check_store(store_path: Path, preset: Preset, digests: dict[str, str]) -> N
     if old_hash is not None and old_hash != preset.config_hash:
         raise SweepError(
             f"{store_path}: its trials ran with config {old_hash}, the current config is "
-            f"{preset.config_hash} (game/defaults.toml or the preset's [set] changed); "
+            f"{preset.config_hash} (a default or the preset's [set] changed); "
             "use another --out")
     _check_levels(store_path, meta.get("level_digests"), digests, preset)
 

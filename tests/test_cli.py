@@ -141,9 +141,9 @@ def test_play_help_lists_the_keys_without_importing_pygame() -> None:
     result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
                             timeout=60)
     assert result.returncode == 0, result.stderr
-    from game.front.keys import KEY_HELP
+    from game.front.keys import key_help
 
-    for keys, what in KEY_HELP:
+    for keys, what in key_help():
         assert keys in result.stdout and what in result.stdout
 
 

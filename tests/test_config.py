@@ -1,30 +1,64 @@
-"""The defaults file, overrides, hashing, and that the TOML agrees with the AI's dataclasses."""
+"""The defaults (the dataclasses, and the file for the keys no class holds), overrides, hashing."""
 
 from __future__ import annotations
 
+import tomllib
 from dataclasses import fields
 
 import pytest
 
-from ai.params import FSMParams, PFParams, PlayerParams, StalenessParams
-from game.config import Config, ConfigError
+from ai.params import PlayerParams, _Params
+from game.config import DEFAULTS_PATH, Config, ConfigError
+from game.schema import parameter_sections
 
 
-@pytest.mark.parametrize(
-    ("section", "params"),
-    [("pf", PFParams), ("fsm", FSMParams), ("staleness", StalenessParams)],
-)
-def test_toml_defaults_equal_the_paper_defaults_in_code(section: str, params: type) -> None:
-    """One source of truth in spirit: the TOML file and the dataclasses never drift apart."""
-    assert Config.defaults().section(section) == {f.name: f.default for f in fields(params)}
+def _params_classes() -> set[type]:
+    """Every parameter dataclass of the product (ai/, game/): subclasses of ``_Params``."""
+    import ai.alert, ai.awareness, ai.radio, ai.roles, ai.stimuli, game.actions  # noqa: E401, F401
+
+    found, todo = set(), [_Params]
+    while todo:
+        for sub in todo.pop().__subclasses__():
+            todo.append(sub)
+            if sub.__module__.split(".")[0] in ("ai", "game"):
+                found.add(sub)
+    return found
 
 
-def test_player_section_matches_player_params() -> None:
-    expected = {f.name: f.default for f in fields(PlayerParams)}
+def test_every_parameter_class_is_the_one_source_of_its_sections_defaults() -> None:
+    """Each class's field defaults are its section's defaults, and the file writes none."""
+    sections = parameter_sections()
+    assert {c for classes in sections.values() for c in classes} == _params_classes()
+    assert len(_params_classes()) == 10
+    with DEFAULTS_PATH.open("rb") as handle:
+        tables = tomllib.load(handle)
+    defaults = Config.defaults()
+    for section, classes in sections.items():
+        expected = {f.name: f.default for cls in classes for f in fields(cls)
+                    if f.name not in cls.from_world}
+        found = defaults.section(section)
+        assert found.pop("enabled", False) is False  # the team rules' switch: the file's
+        assert found == expected, section
+        assert not set(tables.get(section, {})) & {f.name for c in classes for f in fields(c)}
+
+
+def test_player_section_leaves_the_speeds_to_the_world() -> None:
     section = Config.defaults().section("player")
-    for key in ("guard_speed", "player_speed"):  # come from [world] and the scenario
-        expected.pop(key)
-    assert section == expected
+    assert "guard_speed" not in section and "player_speed" not in section
+    assert set(PlayerParams.from_world) == {"guard_speed", "player_speed"}
+
+
+def test_the_config_hash_is_pinned() -> None:
+    """The hash a store's identity holds: the same values as before the defaults moved into
+    the dataclasses (measured on the commit before), so every store still resumes."""
+    assert Config.defaults().hash() == "c53787ba3cd08da1"
+    assert Config.load(["pf.rho=0.9"]).hash() == "6e28a1d79ad34ffd"
+    assert Config.load(["metrics.coverage=seen", "awareness.enabled=true"]).hash() \
+        == "53837f3c38328917"
+    assert len(Config.defaults().as_dict()) == 146
+    from headless.presets import load_preset
+
+    assert load_preset("paper").config_hash == "7647327243295999"
 
 
 def test_paper_table2_values() -> None:

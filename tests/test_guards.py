@@ -9,18 +9,17 @@ from __future__ import annotations
 
 import json
 from collections.abc import Sequence
-from pathlib import Path
 
 import numpy as np
 import pytest
-import tomllib
 from scipy.spatial import Delaunay
 
-from ai import make_guard_ai
+from ai import guard_mode, make_guard_ai
 from ai.baselines import FSMGuards, StalenessGuards
 from ai.pf import PotentialFieldGuards
 from ai.view import GuardAI, WorldView
 from navmesh.graph import NodeGraph
+from game.config import Config
 
 
 def make_view(
@@ -224,13 +223,10 @@ def test_pf_rejects_unknown_parameters() -> None:
 
 
 def test_config_sections_match_the_parameter_classes() -> None:
-    defaults = Path(__file__).resolve().parents[1] / "game" / "defaults.toml"
-    if not defaults.exists():
-        pytest.skip("no game/defaults.toml")
-    config = tomllib.loads(defaults.read_text())
+    config = Config.defaults()
     for mode in ("pf", "fsm", "staleness"):
-        if mode in config:
-            make_guard_ai(mode, config[mode])
+        assert config.section(guard_mode(mode).section)
+        make_guard_ai(mode, config.section(guard_mode(mode).section))
 
 
 # ---------------------------------------------------------------------------- FSM

@@ -5,11 +5,19 @@ These are the two rows of docs/architecture.md's "to add X, touch Y" table done 
 
 from __future__ import annotations
 
-from collections.abc import Iterator
+import ast
+from collections.abc import Iterator, Mapping
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
 
 import numpy as np
 import pytest
 
+from ai.baselines import RandomWalkGuards
+from ai.bounds import POSITIVE
+from ai.params import PFParams, _Params
+from game.errors import ConfigError
 from ai import (
     GUARD_MODES, GuardAI, guard_mode, make_guard_ai, register_guard_mode, unregister_guard_mode,
 )
@@ -96,3 +104,123 @@ def test_a_registered_overlay_is_drawn_from_the_modes_fields(sentry: str) -> Non
         unregister_overlay("T")
     with pytest.raises(ValueError, match="unknown overlay"):
         overlay_key("ticks")
+
+
+# ------------------------------------------------ a registration brings its parameters and names
+
+
+@dataclass(frozen=True)
+class PatrolParams(_Params):
+    """Test-only: one parameter, the patrol's pace."""
+
+    speed: float = 1.0
+
+    bounds = {"speed": POSITIVE}
+
+
+class PatrolGuards(RandomWalkGuards):
+    """Test-only mode: the random walk, built from :class:`PatrolParams`."""
+
+    mode = "patrol"
+
+    def __init__(self, params: Mapping[str, Any] | None = None) -> None:
+        super().__init__(params)
+        self.settings = PatrolParams.from_mapping(params)
+
+
+@pytest.fixture
+def patrol() -> Iterator[str]:
+    register_guard_mode("patrol", PatrolGuards, display="Patrol", short="P",
+                        params=PatrolParams)
+    try:
+        yield "patrol"
+    finally:
+        unregister_guard_mode("patrol")
+
+
+def test_a_registered_mode_brings_its_parameters_table_label_and_play_key(
+        patrol: str, tmp_path: Path) -> None:
+    from game.config import check_value
+    from game.front.keys import key_help, mode_on_key, mode_order
+    from game.schema import bound_of
+    from headless.analysis.tables import GUARD_NAMES, GUARD_SHORT, table_rows, write_table
+
+    # the config: its key, default and bound come from the parameter class
+    assert Config.defaults()["patrol.speed"] == 1.0
+    assert bound_of("patrol.speed") is PatrolParams.bounds["speed"]
+    with pytest.raises(ConfigError, match=r"patrol\.speed = -1\.0: must be in \(0, inf\)"):
+        Config.load(["patrol.speed=-1"])
+    # run_trial with its key runs, and the mode is built with the value
+    spec = TrialSpec(level="maze", guards=patrol, player="maxmin",
+                     overrides=(("patrol.speed", 1.0), ("world.duration", 3.0)))
+    row = run_trial(spec)
+    assert row["guards"] == patrol and row["config"]["patrol.speed"] == 1.0
+    faster = TrialSpec(level="maze", guards=patrol, overrides=(("patrol.speed", 2.5),))
+    guards = make_world(faster).guard_ai
+    assert isinstance(guards, PatrolGuards) and guards.settings.speed == 2.5
+    # Table 3 and the figures name it from the registration
+    assert GUARD_NAMES["patrol"] == "Patrol" and GUARD_SHORT["patrol"] == "P"
+    write_table(table_rows([{**row, **row["metrics"]}]), tmp_path, 1)
+    assert "| Patrol | MaxMin |" in (tmp_path / "table.md").read_text(encoding="utf-8")
+    # play: the next number key after the five built-ins
+    assert mode_order().index(patrol) == 5 and mode_on_key(6) == patrol
+    assert ("1-6", "restart with guards pf/random/fsm/staleness/cheat/patrol") in key_help()
+    unregister_guard_mode(patrol)  # and gone again: no key, no default, no play key
+    with pytest.raises(ConfigError, match="patrol.speed: unknown config key"):
+        check_value("patrol.speed", 1.0)
+    assert patrol not in mode_order() and mode_on_key(6) is None and patrol not in GUARD_NAMES
+
+
+def test_a_section_holds_one_parameter_class(patrol: str) -> None:
+    with pytest.raises(ValueError, match=r"section \[patrol\] already holds"):
+        register_guard_mode("patrol2", PatrolGuards, section="patrol", params=PFParams)
+    register_guard_mode("patrol2", PatrolGuards, section="world", params=PatrolParams)
+    try:
+        with pytest.raises(ConfigError, match=r"patrol2: config section \[world\] is the world's"):
+            Config.defaults()
+    finally:
+        unregister_guard_mode("patrol2")
+
+
+#: the built-ins' names: a table of them belongs to the registry (ai/__init__.py, outside
+#: game/ and headless/); presets and targets/*.toml/csv are data and may name them
+BUILT_IN = ("pf", "random", "fsm", "staleness", "cheat", "maxmin", "safetygraph", "evade")
+
+#: files that use a built-in by name, one choice each, not a table of modes (why):
+CHOOSE_A_MODE = {
+    "headless/cli.py": "the sim / play --guards and --player defaults",
+    "game/env/match.py": "the environment's external guards are PF guards on [pf]",
+    "game/front/play.py": "the player slot of a human game (evade, never asked)",
+    "game/front/screenshots.py": "each screenshot of the docs picks its guards",
+    "headless/mechanics/worlds.py": "the mechanics experiment is PF guards against its players",
+    "headless/mechanics/beyond.py": "ditto: PF guards against MaxMin",
+    "headless/analysis/beside_paper.py": "the paper-literal rows exist for PF only",
+    "headless/sessions/record.py": "a session is compared with the paper's two policies",
+}
+
+
+def _strings(path: Path) -> Iterator[tuple[int, str]]:
+    """The string constants of a module outside its docstrings (doctests are examples)."""
+    tree = ast.parse(path.read_text(encoding="utf-8"))
+    docs = {id(node.body[0].value) for node in ast.walk(tree)
+            if isinstance(node, (ast.Module, ast.ClassDef, ast.FunctionDef, ast.AsyncFunctionDef))
+            and node.body and isinstance(node.body[0], ast.Expr)
+            and isinstance(node.body[0].value, ast.Constant)}
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Constant) and isinstance(node.value, str) and id(node) not in docs:
+            yield node.lineno, node.value
+
+
+def test_no_mode_name_is_written_again_outside_the_registry() -> None:
+    root = Path(__file__).resolve().parents[1]
+    files = sorted(p for d in ("game", "headless") for p in (root / d).rglob("*.py"))
+    # the acceptance grep, docstrings included: `grep -rn '"staleness"' game headless`
+    quoted = [f"{p.relative_to(root)}:{n}" for p in files
+              for n, line in enumerate(p.read_text(encoding="utf-8").splitlines(), 1)
+              if '"staleness"' in line or "'staleness'" in line]
+    assert quoted == []
+    # every built-in but "random" (also a spawn and respawn rule) as a string in code
+    found = {(str(p.relative_to(root)), n, s) for p in files for n, s in _strings(p)
+             if s in BUILT_IN and s != "random"}
+    assert {f for f, _, _ in found} <= set(CHOOSE_A_MODE), sorted(found)
+    assert set(GUARD_MODES) >= set(BUILT_IN[:5])

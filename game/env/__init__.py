@@ -39,6 +39,8 @@ except ImportError as error:  # pragma: no cover - depends on the installation
         "pip install 'stealthfield[rl]'"
     ) from error
 
+from ai import DEFAULT_GUARD_MODE
+
 from .match import (  # re-exported: the env API names them
     GRID_ACTIONS,
     PARTITION_ACTIONS,
@@ -234,8 +236,8 @@ class StealthEnv(gymnasium.Env):
 
     metadata = {"render_modes": ["rgb_array", "human"], "render_fps": 4}
 
-    def __init__(self, level: str = "miami", guards: str = "pf", abstraction: str = "grid",
-                 scenario: str = "capture", **config: Any) -> None:
+    def __init__(self, level: str = "miami", guards: str = DEFAULT_GUARD_MODE,
+                 abstraction: str = "grid", scenario: str = "capture", **config: Any) -> None:
         options, overrides = _split_options(level, abstraction, scenario, config)
         self.match = Match(level, abstraction, scenario, guards, overrides, **options)
         self.render_mode = self.match.render_mode

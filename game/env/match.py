@@ -15,7 +15,7 @@ from typing import Any
 import numpy as np
 from gymnasium import spaces
 
-from ai import make_guard_ai
+from ai import guard_mode
 from ai.pf import PotentialFieldGuards
 from ai.view import PlayerPolicy, WorldView
 from navmesh.graph import NodeGraph, graph_for
@@ -189,7 +189,8 @@ class Match:
             guard_ai: Any = self.guards
         else:
             self.guards = None
-            guard_ai = make_guard_ai(self.guard_mode, self.config.section(self.guard_mode))
+            mode = guard_mode(self.guard_mode)
+            guard_ai = mode.build(self.config.section(mode.section))
         spec = TrialSpec(level=self.level.name, abstraction=self.abstraction,
                          guards=self.guard_mode or "external", player="external",
                          scenario=self.scenario, seed=seed)

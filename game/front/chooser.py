@@ -13,8 +13,10 @@ from collections.abc import Sequence
 import numpy as np
 import pygame
 
+from ai import DEFAULT_GUARD_MODE
+
 from .best import BestResults, describe
-from .keys import MODE_ORDER
+from .keys import mode_order
 from .palette import BACKGROUND, BLOCKED, EXIT_EDGE, FLOOR, GOOD, GUARD, TEXT, TEXT_DIM, WARN, WALL
 
 __all__ = ["LevelCard", "LevelChooser", "thumbnail"]
@@ -83,10 +85,10 @@ class LevelChooser:
     """Level cards in a window; :meth:`run` returns the chosen level name or None, and
     :attr:`mode` is the guard mode chosen with it."""
 
-    def __init__(self, screen: pygame.Surface, names: Sequence[str], mode: str = "pf",
+    def __init__(self, screen: pygame.Surface, names: Sequence[str], mode: str = DEFAULT_GUARD_MODE,
                  best: BestResults | None = None) -> None:
         self.screen, self.names, self.index = screen, list(names), 0
-        self.mode = mode if mode in MODE_ORDER else MODE_ORDER[0]
+        self.mode = mode if mode in mode_order() else mode_order()[0]
         self.best = best if best is not None else BestResults()
         self.cards = [LevelCard(name) for name in self.names]
         self.chosen: str | None = None
@@ -106,8 +108,9 @@ class LevelChooser:
                 self.index = (self.index + 1) % len(self.names)
             elif event.key in (pygame.K_LEFT, pygame.K_a, pygame.K_RIGHT, pygame.K_d):
                 step = -1 if event.key in (pygame.K_LEFT, pygame.K_a) else 1
-                k = MODE_ORDER.index(self.mode)
-                self.mode = MODE_ORDER[(k + step) % len(MODE_ORDER)]
+                modes = mode_order()
+                k = modes.index(self.mode) if self.mode in modes else 0
+                self.mode = modes[(k + step) % len(modes)]
             elif event.key in (pygame.K_RETURN, pygame.K_KP_ENTER):
                 self.chosen, self.running = self.names[self.index], False
             elif event.key == pygame.K_ESCAPE:

@@ -2,21 +2,45 @@
 list them without opening a window.
 
 :mod:`game.front.play` binds the same keys; a test checks that every key listed here does
-what it says.
+what it says. The number keys are the registered guard modes' (:data:`ai.GUARD_MODES`), in
+registration order, so a mode registered later gets the next key.
 
->>> MODE_ORDER[0], KEY_HELP[0]
-('pf', ('W A S D / arrows', 'move the player'))
+>>> mode_order()[:2], key_help()[0]
+(('pf', 'random'), ('W A S D / arrows', 'move the player'))
 """
 
 from __future__ import annotations
 
-__all__ = ["KEY_HELP", "MODE_ORDER", "key_table"]
+from ai import GUARD_MODES
 
-#: Guard modes on the number keys 1, 2, … (SPEC §9 order).
-MODE_ORDER: tuple[str, ...] = ("pf", "random", "fsm", "staleness", "cheat")
+__all__ = ["key_help", "key_table", "mode_on_key", "mode_order"]
 
-#: ``(keys, what they do)`` in the order the help shows them.
-KEY_HELP: tuple[tuple[str, str], ...] = (
+#: number keys 1 … 9
+_NUMBER_KEYS = 9
+
+
+def mode_order() -> tuple[str, ...]:
+    """The guard modes on the number keys 1, 2, … (registration order, SPEC §9's first)."""
+    return tuple(GUARD_MODES)[:_NUMBER_KEYS]
+
+
+def mode_on_key(number: int) -> str | None:
+    """The guard mode on number key ``number`` (1 … 9), or None when no mode is there."""
+    modes = mode_order()
+    return modes[number - 1] if 1 <= number <= len(modes) else None
+
+
+def key_help() -> tuple[tuple[str, str], ...]:
+    """``(keys, what they do)`` in the order the help shows them, the number keys' modes
+    as registered now."""
+    modes = mode_order()
+    return tuple((f"1-{len(modes)}", "restart with guards " + "/".join(modes))
+                 if keys == _MODES else (keys, what) for keys, what in _KEYS)
+
+
+_MODES = "1-N"
+#: ``(keys, what they do)``; the number keys' line (``1-N``) is filled in by :func:`key_help`.
+_KEYS: tuple[tuple[str, str], ...] = (
     ("W A S D / arrows", "move the player"),
     ("Shift", "sprint (footstep noise)"),
     ("left click", "throw a decoy at the pointer"),
@@ -30,7 +54,7 @@ KEY_HELP: tuple[tuple[str, str], ...] = (
     ("O / Tab", "next field overlay (none, I, C, N, P, K, ...)"),
     ("M", "show the grid / navmesh"),
     ("G", "show the guards' plans"),
-    (f"1-{len(MODE_ORDER)}", "restart with guards " + "/".join(MODE_ORDER)),
+    (_MODES, ""),
     ("Enter", "restart"),
     ("N / B", "next / previous level"),
     ("Esc", "quit"),
@@ -39,5 +63,6 @@ KEY_HELP: tuple[tuple[str, str], ...] = (
 
 def key_table() -> str:
     """The keys as an aligned two-column text (``stealth play --help``)."""
-    width = max(len(keys) for keys, _ in KEY_HELP)
-    return "\n".join(f"  {keys:<{width}}  {what}" for keys, what in KEY_HELP)
+    rows = key_help()
+    width = max(len(keys) for keys, _ in rows)
+    return "\n".join(f"  {keys:<{width}}  {what}" for keys, what in rows)

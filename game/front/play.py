@@ -35,7 +35,7 @@ from game.front.render import (
     init_pygame,
     pygame,
 )
-from game.front.keys import KEY_HELP, MODE_ORDER
+from game.front.keys import key_help, mode_on_key
 from navmesh.level import bundled_level_names
 from game.front.screens import Panel
 from game.front.sound import SoundBoard
@@ -48,9 +48,6 @@ from game.scene import OVERLAYS, Scene, SceneBuilder, overlay_key
 from game.trial import TrialSpec
 from game.world import World
 
-
-#: Guard modes on the number keys, in the order of SPEC §9.
-MODE_KEYS: dict[int, str] = {pygame.K_1 + i: mode for i, mode in enumerate(MODE_ORDER)}
 
 #: Stealth mechanics: the World method each input calls, and the label of its messages.
 MECHANICS: dict[str, tuple[Callable[..., Any], str]] = {
@@ -254,8 +251,8 @@ class PlayGame(FrameLoop):
 
     # ------------------------------------------------------------------ input
     def help_items(self) -> list[str]:
-        """The help line: every key of :data:`game.front.keys.KEY_HELP`, shortly."""
-        return [f"{keys} {what.split(' (')[0]}" for keys, what in KEY_HELP]
+        """The help line: every key of :func:`game.front.keys.key_help`, shortly."""
+        return [f"{keys} {what.split(' (')[0]}" for keys, what in key_help()]
 
     def _mechanic(self, method: str, *args: float) -> None:
         action, label = MECHANICS[method]
@@ -308,8 +305,8 @@ class PlayGame(FrameLoop):
             self.next_level()
         elif key == pygame.K_b:
             self.next_level(-1)
-        elif key in MODE_KEYS:
-            self.restart(MODE_KEYS[key])
+        elif pygame.K_1 <= key <= pygame.K_9 and (mode := mode_on_key(key - pygame.K_0)):
+            self.restart(mode)
         elif key == pygame.K_e:
             self._mechanic("activate_decoy")
         elif key == pygame.K_f:
@@ -537,4 +534,4 @@ def _freeze_heap() -> None:
     gc.freeze()
 
 
-__all__ = ["MECHANICS", "MODE_KEYS", "PlayGame", "PlaySettings"]
+__all__ = ["MECHANICS", "PlayGame", "PlaySettings"]

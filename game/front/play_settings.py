@@ -6,6 +6,8 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from typing import Any
 
+from ai import DEFAULT_GUARD_MODE
+
 __all__ = ["PlaySettings", "SessionSink"]
 
 #: What ``--record`` hands the command line for every finished session: the row and trace.
@@ -17,7 +19,7 @@ class PlaySettings:
     """Everything that defines a game; the world is rebuilt from it on restart."""
 
     level: str
-    guards: str = "pf"
+    guards: str = DEFAULT_GUARD_MODE
     abstraction: str = "grid"
     scenario: str = "capture"
     seed: int = 0

@@ -22,12 +22,15 @@ from __future__ import annotations
 import argparse
 import math
 import sys
+import tomllib
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
 import numpy as np
+
+from ai import GUARD_MODES, Names
 
 from .reproducible import save_figure
 from ..commands.failure import GuardedParser, guarded, wants_debug
@@ -56,18 +59,18 @@ class Claim:
     pairs: tuple[tuple[str, str], ...]
 
 
-CLAIMS: tuple[Claim, ...] = (
-    Claim("order", "CaptureRate: Cheat > PF > Staleness > FSM > RandomWalk", "CaptureRate",
-          (("cheat", "pf"), ("pf", "staleness"), ("staleness", "fsm"), ("fsm", "random"))),
-    Claim("pf-capture", "CaptureRate: PF > each of Staleness, FSM, RandomWalk", "CaptureRate",
-          (("pf", "staleness"), ("pf", "fsm"), ("pf", "random"))),
-    Claim("backtracks", "BacktrackCount: PF fewest of the non-cheating guards",
-          "BacktrackCount", (("staleness", "pf"), ("fsm", "pf"), ("random", "pf"))),
-    Claim("coverage", "CoverageRate: PF highest of the realistic guards", "CoverageRate",
-          (("pf", "staleness"), ("pf", "fsm"), ("pf", "random"))),
-    Claim("captures", "CapturesInTime: Staleness > PF (the paper: slightly)", "CapturesInTime",
-          (("staleness", "pf"),)),
-)
+PAPER_CLAIMS = Path(__file__).resolve().parent.parent / "targets" / "paper-claims.toml"
+"""The paper's main claims, transcribed as data (like its Table 3, they name guard modes)."""
+
+
+def _load_claims(path: Path) -> tuple[Claim, ...]:
+    with path.open("rb") as handle:
+        claims = tomllib.load(handle)["claim"]
+    return tuple(Claim(c["name"], c["title"], c["measure"],
+                       tuple((a, b) for a, b in c["pairs"])) for c in claims)
+
+
+CLAIMS: tuple[Claim, ...] = _load_claims(PAPER_CLAIMS)
 """The paper's main claims as comparisons (``(a, b)``: a's value exceeds b's)."""
 
 
@@ -176,7 +179,8 @@ def judge(trials: Sequence[Mapping[str, Any]], claims: Sequence[Claim] = CLAIMS,
     return keys, judgements
 
 
-_SHORT = {"pf": "PF", "random": "RW", "fsm": "FSM", "staleness": "Stal", "cheat": "Cheat"}
+#: a mode's name in a verdict: its registered ``abbrev`` (:mod:`ai`)
+_SHORT = Names(GUARD_MODES, "abbrev")
 _MARK = {"holds": "✓", "fails": "✗", "undecided": "?"}
 
 

@@ -13,6 +13,7 @@ from collections.abc import Iterable, Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
+from ai import GUARD_MODES, PLAYER_POLICIES, Names
 from game.metrics import TableColumn, metric_names, registered_metrics
 
 from .stats import Stat, summarise
@@ -22,11 +23,12 @@ __all__ = ["ABSTRACTION_NAMES", "GUARD_NAMES", "GUARD_SHORT", "PLAYER_NAMES", "P
            "label", "metric_value", "table_columns", "table_rows", "write_table",
            "write_trials_csv"]
 
-GUARD_NAMES = {"cheat": "Cheat", "fsm": "FSM", "pf": "PotentialField", "random": "RandomWalk",
-               "staleness": "Staleness"}
-GUARD_SHORT = {"cheat": "C", "fsm": "FSM", "pf": "PF", "random": "RW", "staleness": "S"}
-PLAYER_NAMES = {"maxmin": "MaxMin", "safetygraph": "SafetyGraph", "evade": "Evade"}
-PLAYER_SHORT = {"maxmin": "MM", "safetygraph": "SG", "evade": "EV"}
+#: the registered modes' and policies' names (:mod:`ai`), read live: a mode registered
+#: later has its label in every table and figure
+GUARD_NAMES = Names(GUARD_MODES, "display")
+GUARD_SHORT = Names(GUARD_MODES, "short")
+PLAYER_NAMES = Names(PLAYER_POLICIES, "display")
+PLAYER_SHORT = Names(PLAYER_POLICIES, "short")
 ABSTRACTION_NAMES = {"grid": "Grid", "partition": "Partition"}
 
 
