@@ -67,17 +67,20 @@ def check_action(space: spaces.Discrete, action: Any, who: str = "the agent") ->
     """``action`` as an int, or a ValueError naming it when it is not in ``space``.
 
     ``Discrete.contains`` refuses floats, strings and out-of-range integers (numpy's
-    ``-1`` included), so ``step(1.7)`` cannot silently become action 1.
+    ``-1`` included), so ``step(1.7)`` cannot silently become action 1; booleans (Python's
+    or numpy's, which ``contains`` takes) are refused here, so ``step(True)`` is not 1.
     """
     kind = type(action)
     if kind is int or kind is np.int64:  # the usual cases, without contains()'s dtype checks
         start = int(space.start)
         if start <= action < start + int(space.n):
             return int(action)
-    try:
-        ok = space.contains(action)
-    except (TypeError, ValueError):
-        ok = False
+    ok = False
+    if not isinstance(action, (bool, np.bool_)) and getattr(action, "dtype", None) != np.bool_:
+        try:
+            ok = space.contains(action)
+        except (TypeError, ValueError):
+            ok = False
     if not ok:
         raise ValueError(f"invalid action {action!r} for {who}: expected an integer in "
                          f"[0, {space.n - 1}] ({space})")

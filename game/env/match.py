@@ -81,6 +81,23 @@ def _direction_table(graph: NodeGraph) -> np.ndarray:
     return moves
 
 
+def _render_size(size: Any) -> tuple[int, int]:
+    """``size`` as ``(width, height)`` of positive whole pixels, or a ValueError naming it.
+
+    Refused here, at construction, rather than inside pygame at the first ``render()``.
+    """
+    try:
+        width, height = size
+    except (TypeError, ValueError):
+        width = height = None
+    ok = all(isinstance(v, (int, np.integer)) and not isinstance(v, bool) and 0 < v <= 8192
+             for v in (width, height))
+    if not ok:
+        raise ValueError(f"render_size must be (width, height) in whole pixels in [1, 8192], "
+                         f"not {size!r}")
+    return int(width), int(height)  # type: ignore[arg-type]
+
+
 class ExternalPlayer(PlayerPolicy):
     """The player as an env agent: each decision goes where the current action points.
 
@@ -149,6 +166,12 @@ class Match:
         unknown = set(rewards or {}) - set(REWARDS)
         if unknown:
             raise ValueError(f"unknown reward terms {sorted(unknown)} (choose from {list(REWARDS)})")
+        for term, weight in (rewards or {}).items():
+            if isinstance(weight, bool) or not isinstance(weight, (int, float, np.integer, np.floating)) \
+                    or not math.isfinite(weight):
+                raise ValueError(f"reward weight {term!r} must be a finite number, not {weight!r}")
+        if render_size is not None:
+            render_size = _render_size(render_size)
         self.level = cached_level(level)
         self.abstraction, self.scenario, self.guard_mode = abstraction, scenario, guard_mode
         self.overrides = dict(overrides)
@@ -166,9 +189,13 @@ class Match:
             cfg[f"scenario.{scenario}.view_range_scale"])
         speed = float(cfg["world.player_speed"]) * float(
             cfg[f"scenario.{scenario}.player_speed_scale"])
-        #: physics steps a "stay" lasts: as long as a move along a mean edge takes
-        self.hold_steps = max(1, math.ceil(self.graph.mean_edge_length / speed / self.dt - 1e-9))
-        self.max_steps = max(self.hold_steps, math.ceil(2 * float(cfg["world.stuck_timeout"]) / self.dt))
+        #: physics steps a "stay" lasts: as long as a move along a mean edge takes, at most a
+        #: whole step's limit (a player too slow to cross an edge within it, e.g. a speed of
+        #: 5e-324, holds that long; the quotient itself may be infinite)
+        limit = math.ceil(2 * float(cfg["world.stuck_timeout"]) / self.dt)
+        hold = self.graph.mean_edge_length / speed / self.dt - 1e-9
+        self.hold_steps = max(1, math.ceil(hold)) if hold < limit else max(1, limit)
+        self.max_steps = max(self.hold_steps, limit)
         self.ends_on_capture = bool(cfg[f"scenario.{scenario}.end_on_capture"])
         #: node positions as Python floats (the same values as the graph's rows)
         self._points: list[list[float]] = self.graph.positions.tolist()
@@ -209,11 +236,19 @@ class Match:
         return self.info()
 
     def danger(self) -> float:
-        """The shaping potential now (negated): ``seen`` × seen + ``proximity`` × nearness."""
+        """The shaping potential now (negated): ``seen`` × seen + ``proximity`` × nearness.
+
+        Nearness falls linearly from 1 (a guard on the player's node) to 0 at the view
+        range; blind guards (view range 0) are near only on the player's node (the limit).
+        """
         r = self.rewards
         out = r["seen"] * bool(self.world.seen_by)
         if r["proximity"]:
-            out += r["proximity"] * max(0.0, 1.0 - self.guard_distance() / self.view_range)
+            distance = self.guard_distance()
+            if self.view_range > 0:
+                out += r["proximity"] * max(0.0, 1.0 - distance / self.view_range)
+            elif distance == 0:
+                out += r["proximity"]
         return out
 
     def info(self) -> dict[str, Any]:
