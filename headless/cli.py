@@ -178,6 +178,8 @@ def _cmd_play(args: argparse.Namespace) -> int:
 
     from .outputs.clobber import level_file, plugin_files, refuse_inputs_all
 
+    if args.questions and args.record is None:
+        raise UsageError("--questions: the ratings are stored with the session: give --record DIR too")
     inputs = [level_file(args.level), args.config, *plugin_files(args.stimulus)]
     refuse_inputs_all("--screenshot/--record", [p for p in (args.screenshot, args.record) if p],
                       inputs)
@@ -393,7 +395,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--autopilot", choices=policies, default=None,
                    help="let a player policy play; a movement key takes over (default: you play)")
     p.add_argument("--frames", type=int, default=None,
-                   help="stop after N frames, one physics step each (default: play until Esc)")
+                   help="stop after N frames, one physics step each (default: play until Esc); "
+                   "without a level the chooser, too, ends after N frames unless a level is chosen")
     p.add_argument("--screenshot", default=None, metavar="FILE.png",
                    help="save the last frame as PNG (default: none)")
     p.add_argument("--overlay", default="none",
