@@ -11,7 +11,7 @@ import pytest
 pytest.importorskip("gymnasium")
 pytest.importorskip("pettingzoo")
 
-from game.env import REWARDS, StealthEnv, parallel_env  # noqa: E402
+from game.env import REWARDS, StealthEnv, StealthVectorEnv, parallel_env  # noqa: E402
 
 
 @pytest.mark.parametrize("blind", [{"world__view_range": 0.0},
@@ -48,7 +48,7 @@ def test_booleans_are_not_actions(action: object) -> None:
         penv.step({"player": 0, "guard_0": action})
 
 
-@pytest.mark.parametrize("weight", [math.nan, math.inf, -math.inf, "1", None, True])
+@pytest.mark.parametrize("weight", [math.nan, math.inf, -math.inf, "1", None, True, 1e308, -2e6])
 def test_reward_weights_must_be_finite_numbers(weight: object) -> None:
     with pytest.raises(ValueError, match="reward weight 'survival' must be a finite number"):
         StealthEnv("maze", rewards={"survival": weight})
@@ -79,3 +79,26 @@ def test_a_vanishing_player_speed_stays_put() -> None:
         if term or trunc:
             break
     assert tuple(m.world.player.pos) == pytest.approx(start, abs=1e-9)
+
+
+@pytest.mark.parametrize(("options", "words"), [
+    ({"obs_radius": 10**9}, "obs_radius must be a whole number of cells in [0, 256]"),
+    ({"obs_radius": 2.5}, "obs_radius must be"),
+    ({"obs_radius": True}, "obs_radius must be"),
+    ({"obs_radius": "3"}, "obs_radius must be"),
+    ({"rewards": []}, "rewards must be a dict"),
+    ({"rewards": "survival"}, "rewards must be a dict"),
+    ({"scenario": "nope"}, "unknown scenario 'nope'"),
+    ({"overrides": "world.guards=2"}, "overrides must be a dict"),
+])
+def test_options_of_the_wrong_kind_are_refused_naming_them(options: dict, words: str) -> None:
+    with pytest.raises(ValueError, match=words.replace("[", r"\[").replace("]", r"\]")):
+        StealthEnv("maze", **options)
+
+
+def test_vector_and_parallel_options_are_checked() -> None:
+    for n in (10**9, 0, 2.7, True):
+        with pytest.raises(ValueError, match="num_envs must be a whole number in"):
+            StealthVectorEnv(num_envs=n, level="maze")
+    with pytest.raises(ValueError, match="pad_observations must be True or False"):
+        parallel_env("maze", pad_observations="no")

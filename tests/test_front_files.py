@@ -27,6 +27,8 @@ CORRUPT = {
     "array of modes": '{"maze": [1, 2]}',
     "time not a number": '{"maze": {"pf": {"outcome": "won", "time": "abc"}}}',
     "time NaN": '{"maze": {"pf": {"outcome": "won", "time": NaN}}}',
+    "time of 400 digits": '{"maze": {"pf": {"outcome": "won", "time": ' + "9" * 400 + "}}}",
+    "time negative": '{"maze": {"pf": {"outcome": "won", "time": -3}}}',
     "null": "null",
     "result not an object": '{"maze": {"pf": 3}}',
     "no outcome": '{"maze": {"pf": {"time": 3}}}',

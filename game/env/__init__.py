@@ -91,7 +91,10 @@ def _split_options(level: str, abstraction: str, scenario: str, kwargs: dict[str
                    ) -> tuple[dict[str, Any], dict[str, Any]]:
     """Env options and config overrides (``world__guards=2`` means ``world.guards=2``)."""
     options = {k: kwargs.pop(k) for k in _OPTIONS if k in kwargs}
-    overrides = dict(options.pop("overrides", None) or {})
+    given = options.pop("overrides", None)
+    if given is not None and not isinstance(given, Mapping):
+        raise ValueError(f"overrides must be a dict of config keys, not {given!r}")
+    overrides = dict(given or {})
     for key, value in kwargs.items():
         overrides[key.replace("__", ".")] = value
     return options, overrides
@@ -109,6 +112,8 @@ class StealthParallelEnv(ParallelEnv):
     def __init__(self, level: str = "miami", abstraction: str = "grid",
                  scenario: str = "capture", pad_observations: bool = True,
                  **config: Any) -> None:
+        if not isinstance(pad_observations, (bool, np.bool_)):
+            raise ValueError(f"pad_observations must be True or False, not {pad_observations!r}")
         options, overrides = _split_options(level, abstraction, scenario, config)
         self.match = Match(level, abstraction, scenario, None, overrides, **options)
         self.render_mode = self.match.render_mode
@@ -272,6 +277,11 @@ class StealthEnv(gymnasium.Env):
         self.match.close()
 
 
+#: The most worlds one :class:`StealthVectorEnv` steps in turn in one process (10^9 ran
+#: out of memory after 38 s); more belong in several processes.
+MAX_NUM_ENVS = 1024
+
+
 class StealthVectorEnv(gymnasium.vector.SyncVectorEnv):
     """``num_envs`` :class:`StealthEnv` worlds stepped in turn in this process.
 
@@ -283,8 +293,10 @@ class StealthVectorEnv(gymnasium.vector.SyncVectorEnv):
     """
 
     def __init__(self, num_envs: int = 1, **kwargs: Any) -> None:
-        if int(num_envs) < 1:
-            raise ValueError(f"num_envs must be >= 1, not {num_envs!r}")
+        if isinstance(num_envs, bool) or not isinstance(num_envs, (int, np.integer)) \
+                or not 1 <= num_envs <= MAX_NUM_ENVS:
+            raise ValueError(f"num_envs must be a whole number in [1, {MAX_NUM_ENVS}], "
+                             f"not {num_envs!r}")
         super().__init__([lambda: StealthEnv(**kwargs) for _ in range(int(num_envs))])
 
     def action_masks(self) -> np.ndarray:

@@ -24,7 +24,7 @@ from navmesh.level import cached_level
 from ..config import Config
 from .observations import OBS_BOUND, Observer
 from ..trial import TrialSpec, make_world
-from ..world import World
+from ..world import SCENARIOS, World
 
 __all__ = ["ExternalGuards", "ExternalPlayer", "GRID_ACTIONS", "Match", "PARTITION_ACTIONS",
            "REWARDS"]
@@ -79,6 +79,31 @@ def _direction_table(graph: NodeGraph) -> np.ndarray:
                     moves[node, a] = int(options[ok][np.argmax(along[ok])])
                     break
     return moves
+
+
+#: The largest ``obs_radius``: a window of 513 × 513 cells per channel (about 5 MB a
+#: guard's observation); a larger one would only pad a bundled level with zeros.
+MAX_OBS_RADIUS = 256
+#: The largest reward weight in absolute value: a 60-s return stays far from overflowing
+#: (1e308 per second survived made the reward inf).
+MAX_REWARD_WEIGHT = 1e6
+
+
+def _check_rewards(rewards: Any) -> None:
+    """Refuse ``rewards`` other than a dict of known terms to finite weights within
+    ±:data:`MAX_REWARD_WEIGHT` (a ValueError naming the term), at construction."""
+    if rewards is None:
+        return
+    if not isinstance(rewards, Mapping):
+        raise ValueError(f"rewards must be a dict of reward terms to weights, not {rewards!r}")
+    unknown = set(rewards) - set(REWARDS)
+    if unknown:
+        raise ValueError(f"unknown reward terms {sorted(unknown)} (choose from {list(REWARDS)})")
+    for term, weight in rewards.items():
+        if isinstance(weight, bool) or not isinstance(weight, (int, float, np.integer, np.floating)) \
+                or not abs(weight) <= MAX_REWARD_WEIGHT:
+            raise ValueError(f"reward weight {term!r} must be a finite number in "
+                             f"[-{MAX_REWARD_WEIGHT:g}, {MAX_REWARD_WEIGHT:g}], not {weight!r}")
 
 
 def _render_size(size: Any) -> tuple[int, int]:
@@ -163,13 +188,13 @@ class Match:
             raise ValueError(f"unknown abstraction {abstraction!r} (choose grid or partition)")
         if render_mode not in (None, "rgb_array", "human"):
             raise ValueError(f"unknown render_mode {render_mode!r} (choose rgb_array or human)")
-        unknown = set(rewards or {}) - set(REWARDS)
-        if unknown:
-            raise ValueError(f"unknown reward terms {sorted(unknown)} (choose from {list(REWARDS)})")
-        for term, weight in (rewards or {}).items():
-            if isinstance(weight, bool) or not isinstance(weight, (int, float, np.integer, np.floating)) \
-                    or not math.isfinite(weight):
-                raise ValueError(f"reward weight {term!r} must be a finite number, not {weight!r}")
+        if scenario not in SCENARIOS:
+            raise ValueError(f"unknown scenario {scenario!r} (choose from {', '.join(SCENARIOS)})")
+        _check_rewards(rewards)
+        if isinstance(obs_radius, bool) or not isinstance(obs_radius, (int, np.integer)) \
+                or not 0 <= obs_radius <= MAX_OBS_RADIUS:
+            raise ValueError(f"obs_radius must be a whole number of cells in [0, {MAX_OBS_RADIUS}], "
+                             f"not {obs_radius!r}")
         if render_size is not None:
             render_size = _render_size(render_size)
         self.level = cached_level(level)

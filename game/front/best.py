@@ -18,7 +18,6 @@ False
 from __future__ import annotations
 
 import json
-import math
 import os
 import sys
 import tempfile
@@ -29,6 +28,7 @@ __all__ = ["BestResults", "better", "data_dir", "describe"]
 
 _RANK = {"won": 4, "survived": 3, "time up": 2, "caught": 1}
 _MAX_BYTES = 1 << 20
+_MAX_TIME = 1e9  # seconds of game time a result may name (a trial's limit is 5 × 10^4 s)
 
 
 def data_dir() -> Path:
@@ -74,7 +74,7 @@ def _json_kind(value: Any) -> str:
 def _shape_problem(loaded: Any) -> str | None:
     """What makes ``loaded`` other than ``{level: {mode: result}}`` (None: nothing).
 
-    A result is an object with an ``outcome`` string, a finite number ``time`` and, if any,
+    A result is an object with an ``outcome`` string, a ``time`` in [0, 10^9] s and, if any,
     a whole number ``stars`` >= 0: what :func:`better` and :func:`describe` read.
     """
     if not isinstance(loaded, dict):
@@ -89,8 +89,9 @@ def _shape_problem(loaded: Any) -> str | None:
             time, stars = result.get("time"), result.get("stars", 0)
             if not isinstance(result.get("outcome"), str):
                 return f"{where}: outcome is not a string"
-            if isinstance(time, bool) or not isinstance(time, (int, float)) or not math.isfinite(time):
-                return f"{where}: time {time!r} is not a finite number"
+            if isinstance(time, bool) or not isinstance(time, (int, float)) or not 0 <= time <= _MAX_TIME:
+                shown = repr(time) if len(repr(time)) <= 30 else repr(time)[:12] + "…"
+                return f"{where}: time {shown} is not a number of seconds in [0, {_MAX_TIME:g}]"
             if stars is not None and (isinstance(stars, bool) or not isinstance(stars, int) or stars < 0):
                 return f"{where}: stars {stars!r} is not a whole number >= 0"
     return None

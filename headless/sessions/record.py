@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import os
 import re
+import sqlite3
 import sys
 from collections.abc import Mapping, Sequence
 from pathlib import Path
@@ -37,6 +38,23 @@ def session_trace(directory: str | Path, key: str) -> Path:
     return Path(directory) / "sessions" / f"{name}.jsonl"
 
 
+def _check_existing(directory: Path) -> None:
+    """Refuse, before a game is played, what would lose its session at the end: a
+    ``sessions`` that is not a folder, a store file that is not a regular SQLite file."""
+    sessions, store = directory / "sessions", directory / STORE_NAME
+    if (sessions.exists() or sessions.is_symlink()) and not sessions.is_dir():
+        raise UserError(f"--record {directory}: {sessions} is not a folder")
+    if not (store.exists() or store.is_symlink()):
+        return
+    if not store.is_file():
+        raise UserError(f"--record {directory}: {store} is not a regular file")
+    try:
+        with ResultStore(store, readonly=True):
+            pass
+    except sqlite3.DatabaseError as error:
+        raise UserError(f"--record {directory}: {store} is not a results store ({error})") from None
+
+
 class SessionStore:
     """Writes sessions (and their comparison trials) into one results directory."""
 
@@ -52,6 +70,7 @@ class SessionStore:
         if not parent.is_dir() or not os.access(parent, os.W_OK | os.X_OK):
             raise UserError(f"--record {directory}: cannot create the folder "
                             f"({parent} is not a writable folder)")
+        _check_existing(self.directory)
         self.overrides = tuple(overrides)
         self.stored: list[str] = []
 
