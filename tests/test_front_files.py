@@ -32,6 +32,7 @@ CORRUPT = {
     "null": "null",
     "result not an object": '{"maze": {"pf": 3}}',
     "no outcome": '{"maze": {"pf": {"time": 3}}}',
+    "outcome with a NUL": '{"maze": {"pf": {"outcome": "\\u0000", "time": 3}}}',
     "negative stars": '{"maze": {"pf": {"outcome": "won", "time": 3, "stars": -1}}}',
     "deep": DEEP,
     "not JSON": "{not json",
@@ -79,12 +80,14 @@ def test_the_chooser_draws_from_a_set_aside_file(tmp_path: Path) -> None:
 
 def test_play_starts_with_a_deeply_nested_best_file_and_the_chooser_stops(tmp_path: Path) -> None:
     """``stealth play --frames 30`` without a level: the chooser gives up after 30 frames
-    (it waited for a key for ever), and the deep best file is set aside on the way."""
+    (it waited for a key for ever), saves its frame for ``--screenshot``, and the deep best
+    file is set aside on the way."""
     (tmp_path / "best.json").write_text(DEEP)
-    done = _stealth("play", "--frames", "30", data=tmp_path)
+    shot = tmp_path / "chooser.png"
+    done = _stealth("play", "--frames", "30", "--screenshot", str(shot), data=tmp_path)
     assert done.returncode == 0, done.stderr
     assert "Traceback" not in done.stderr and "set aside" in done.stderr
-    assert (tmp_path / "best.json.corrupt").exists()
+    assert (tmp_path / "best.json.corrupt").exists() and shot.stat().st_size > 1000
 
 
 def test_a_refused_recorded_game_creates_nothing(tmp_path: Path) -> None:

@@ -81,3 +81,15 @@ def test_a_searched_duration_counts_at_its_longest(tmp_path: Path) -> None:
     _refused(_tune(tmp_path, "--out", str(tmp_path / "out"), "--trials", "10000", spec=spec),
              "physics steps in all")
     assert not (tmp_path / "out").exists()
+
+
+def test_run_refuses_a_study_directory(tmp_path: Path) -> None:
+    """The converse: `stealth run --out` a study's directory would make the study refused."""
+    out = tmp_path / "study"
+    out.mkdir()
+    (out / "study.db").write_bytes(b"")
+    done = subprocess.run([sys.executable, "-m", "headless.cli", "run", "--preset", "smoke",
+                           "--out", str(out), "--workers", "1"], capture_output=True, text=True,
+                          timeout=60, env={**os.environ, "PYTHONPATH": str(ROOT)})
+    _refused(done, "holds a study (study.db of stealth tune)")
+    assert sorted(p.name for p in out.iterdir()) == ["study.db"]

@@ -74,7 +74,7 @@ def _json_kind(value: Any) -> str:
 def _shape_problem(loaded: Any) -> str | None:
     """What makes ``loaded`` other than ``{level: {mode: result}}`` (None: nothing).
 
-    A result is an object with an ``outcome`` string, a ``time`` in [0, 10^9] s and, if any,
+    A result is an object with an ``outcome`` the game writes (a key of ``_RANK``), a ``time`` in [0, 10^9] s and, if any,
     a whole number ``stars`` >= 0: what :func:`better` and :func:`describe` read.
     """
     if not isinstance(loaded, dict):
@@ -87,8 +87,9 @@ def _shape_problem(loaded: Any) -> str | None:
             if not isinstance(result, dict):
                 return f"{where} is {_json_kind(result)}, not a result"
             time, stars = result.get("time"), result.get("stars", 0)
-            if not isinstance(result.get("outcome"), str):
-                return f"{where}: outcome is not a string"
+            if result.get("outcome") not in _RANK:
+                shown = repr(result.get("outcome"))[:30]
+                return f"{where}: outcome {shown} is not one of {', '.join(_RANK)}"
             if isinstance(time, bool) or not isinstance(time, (int, float)) or not 0 <= time <= _MAX_TIME:
                 shown = repr(time) if len(repr(time)) <= 30 else repr(time)[:12] + "…"
                 return f"{where}: time {shown} is not a number of seconds in [0, {_MAX_TIME:g}]"

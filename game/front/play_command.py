@@ -81,7 +81,10 @@ def cmd_play(args: argparse.Namespace, on_session: SessionSink | None = None) ->
                                mode=args.guards)
         level = chooser.run(args.frames)  # --frames: no choice within N frames ends play
         if level is None:
-            pygame.display.quit()
+            try:
+                finish(chooser.screen, args.screenshot, [])  # --screenshot: the chooser's frame
+            finally:
+                pygame.display.quit()
             return 0
         args.guards = chooser.mode
     settings = PlaySettings(
