@@ -114,3 +114,12 @@ def test_a_plugin_given_for_a_trial_without_one_is_refused(
     plugin = str(ROOT / "examples" / "tripwire.py") + ":Tripwire"
     assert main(["sim", "--from", str(out), "--trial", key, "--stimulus", plugin]) == 2
     _one_line(capsys, "it ran without plugin stimuli; drop --stimulus")
+
+
+def test_a_plugin_path_that_is_not_a_file_says_so(tmp_path: Path,
+                                                  capsys: pytest.CaptureFixture[str]) -> None:
+    import os
+
+    os.mkfifo(tmp_path / "pipe.py")
+    assert main(["sim", "maze", "--stimulus", f"{tmp_path}/pipe.py:X"]) == 2
+    _one_line(capsys, "not a regular file")

@@ -107,3 +107,20 @@ def test_questions_need_record(tmp_path: Path) -> None:
     assert done.returncode == 2
     assert done.stderr == ("stealth: error: --questions: the ratings are stored with the "
                            "session: give --record DIR too\n")
+
+
+@pytest.mark.parametrize("spoil", ["sessions file", "store junk", "store fifo"])
+def test_a_record_folder_that_would_lose_the_session_is_refused_first(spoil: str,
+                                                                       tmp_path: Path) -> None:
+    """Refused before the game (3 frames: no session), not after it is played."""
+    out = tmp_path / "rec"
+    out.mkdir()
+    if spoil == "sessions file":
+        (out / "sessions").write_text("")
+    elif spoil == "store junk":
+        (out / "results.sqlite").write_text("junk")
+    else:
+        os.mkfifo(out / "results.sqlite")
+    done = _stealth("play", "maze", "--frames", "3", "--record", str(out), data=tmp_path)
+    assert done.returncode == 2 and done.stderr.startswith(f"stealth: error: --record {out}: ")
+    assert done.stderr.count("\n") == 1
