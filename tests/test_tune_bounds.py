@@ -13,25 +13,13 @@ import pytest
 
 from game.budget import MAX_DESIGN_STEPS
 from headless.tune.study import MAX_STUDY_TRIALS
+from test_tune import SPEC as TINY_SPEC
 
 pytest.importorskip("optuna")
 
 ROOT = Path(__file__).resolve().parent.parent
-SPEC = """
-levels = ["maze"]
-abstractions = ["grid"]
-guards = ["pf"]
-players = ["maxmin"]
-scenarios = ["capture", "fixed"]
-seeds_train = 1
-seeds_test = 1
-[set]
-"world.duration" = 3.0
-[search]
-"world.guard_speed" = {low = 1.5, high = 3.0}
-[objective]
-maximize = "coverage"
-"""
+# the tiny study of test_tune.py: maze, grid, pf × maxmin, capture and fixed, 1 + 1 seeds
+SPEC = TINY_SPEC
 
 
 def _tune(tmp_path: Path, *args: str, spec: str = SPEC) -> subprocess.CompletedProcess[str]:
@@ -68,6 +56,7 @@ def test_the_study_steps_are_within_the_sweeps_budget(tmp_path: Path) -> None:
     steps > 2e9."""
     spec = SPEC.replace('"world.duration" = 3.0', "").replace("seeds_train = 1",
                                                               "seeds_train = 2000")
+    assert "seeds_train = 2000" in spec and "world.duration" not in spec
     _refused(_tune(tmp_path, "--out", str(tmp_path / "out"), "--trials", "10000", spec=spec),
              f"physics steps in all, more than the limit of {MAX_DESIGN_STEPS}")
     assert not (tmp_path / "out").exists()
@@ -78,6 +67,7 @@ def test_a_searched_duration_counts_at_its_longest(tmp_path: Path) -> None:
     spec = SPEC.replace('"world.guard_speed" = {low = 1.5, high = 3.0}',
                         '"world.duration" = {low = 1.0, high = 50000.0}').replace(
                             '"world.duration" = 3.0', "")
+    assert '"world.duration" = {low' in spec
     _refused(_tune(tmp_path, "--out", str(tmp_path / "out"), "--trials", "10000", spec=spec),
              "physics steps in all")
     assert not (tmp_path / "out").exists()

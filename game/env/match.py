@@ -99,9 +99,10 @@ def _check_rewards(rewards: Any) -> None:
     unknown = set(rewards) - set(REWARDS)
     if unknown:
         raise ValueError(f"unknown reward terms {sorted(unknown)} (choose from {list(REWARDS)})")
-    for term, weight in rewards.items():
+    weights: dict[str, Any] = dict(rewards)
+    for term, weight in weights.items():
         if isinstance(weight, bool) or not isinstance(weight, (int, float, np.integer, np.floating)) \
-                or not abs(weight) <= MAX_REWARD_WEIGHT:
+                or not -MAX_REWARD_WEIGHT <= weight <= MAX_REWARD_WEIGHT:  # NaN fails it
             raise ValueError(f"reward weight {term!r} must be a finite number in "
                              f"[-{MAX_REWARD_WEIGHT:g}, {MAX_REWARD_WEIGHT:g}], not {weight!r}")
 
@@ -120,7 +121,7 @@ def _render_size(size: Any) -> tuple[int, int]:
     if not ok:
         raise ValueError(f"render_size must be (width, height) in whole pixels in [1, 8192], "
                          f"not {size!r}")
-    return int(width), int(height)  # type: ignore[arg-type]
+    return int(width), int(height)
 
 
 class ExternalPlayer(PlayerPolicy):

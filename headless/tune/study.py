@@ -376,7 +376,7 @@ def _worst(spec: TuneSpec, key: str, config: Mapping[str, Any], largest: bool) -
     or choice when it is searched, else the design's value."""
     for p in spec.params:
         if p.key == key:
-            values = list(p.choices) if p.choices else [p.low, p.high]
+            values = [float(v) for v in (p.choices if p.choices else (p.low, p.high))]
             return max(values) if largest else min(values)
     return config[key]
 
