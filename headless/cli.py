@@ -417,7 +417,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--record", default=None, metavar="DIR",
                    help="store every game as a trial (player human) in the results store DIR")
     p.add_argument("--questions", action="store_true",
-                   help="with --record: ask three 1-5 ratings after each game")
+                   help="with --record (refused without it): ask three 1-5 ratings after each game")
     p.set_defaults(func=_cmd_play)
 
     p = command("replay", "replay a trace written by stealth sim --trace, or a stored trial")
