@@ -74,16 +74,17 @@ def _json_kind(value: Any) -> str:
 def _shape_problem(loaded: Any) -> str | None:
     """What makes ``loaded`` other than ``{level: {mode: result}}`` (None: nothing).
 
-    A result is an object with an ``outcome`` the game writes (a key of ``_RANK``), a ``time`` in [0, 10^9] s and, if any,
-    a whole number ``stars`` >= 0: what :func:`better` and :func:`describe` read.
+    A result is an object with an ``outcome`` the game writes (a key of ``_RANK``), a
+    ``time`` in [0, 10^9] s and, if any, a whole number ``stars`` >= 0: what :func:`better`
+    and :func:`describe` read. Names in the message are cut to 30 characters.
     """
     if not isinstance(loaded, dict):
         return f"{_json_kind(loaded)}, not an object"
     for level, modes in loaded.items():
         if not isinstance(modes, dict):
-            return f"{level!r} is {_json_kind(modes)}, not an object of guard modes"
+            return f"{level!r:.30} is {_json_kind(modes)}, not an object of guard modes"
         for mode, result in modes.items():
-            where = f"{level!r}/{mode!r}"
+            where = f"{level!r:.30}/{mode!r:.30}"
             if not isinstance(result, dict):
                 return f"{where} is {_json_kind(result)}, not a result"
             time, stars = result.get("time"), result.get("stars", 0)
@@ -94,7 +95,7 @@ def _shape_problem(loaded: Any) -> str | None:
                 shown = repr(time) if len(repr(time)) <= 30 else repr(time)[:12] + "…"
                 return f"{where}: time {shown} is not a number of seconds in [0, {_MAX_TIME:g}]"
             if stars is not None and (isinstance(stars, bool) or not isinstance(stars, int) or stars < 0):
-                return f"{where}: stars {stars!r} is not a whole number >= 0"
+                return f"{where}: stars {stars!r:.30} is not a whole number >= 0"
     return None
 
 
