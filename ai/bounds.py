@@ -61,8 +61,8 @@ class Range:
         noun = "a whole number" if self.integer else "a number"
         if isinstance(value, bool) or not isinstance(value, (int, float)):
             return f"must be {noun} in {span}"
-        if not math.isfinite(value):
-            return f"must be a finite {noun[2:]} in {span}"
+        if isinstance(value, float) and not math.isfinite(value):  # an int always is (and
+            return f"must be a finite {noun[2:]} in {span}"  # beyond 1e308 cannot be a float)
         above = value > self.low if self.low_open else value >= self.low
         below = value < self.high if self.high_open else value <= self.high
         if (self.integer and int(value) != value) or not (above and below):

@@ -156,7 +156,7 @@ def field_matrices(graph: NodeGraph, params: PFParams) -> FieldMatrices:
         params.gamma_I,
         params.gamma_C,
         params.kernel_lambda,
-        float(params.kernel_radius),
+        params.kernel_radius,  # not float(): a whole number beyond 1e308 is in range
         params.r_edge_factor,
     )
     per_graph = _MATRIX_CACHE.setdefault(graph, OrderedDict())

@@ -79,7 +79,8 @@ def load_stimulus(spec: str) -> StimulusFactory:
         if not attr.isidentifier():
             raise StimulusError(f"{text}: {attr!r} is not a Python name")
         if not path.is_file():
-            raise StimulusError(f"{text}: no such file {path_text}")
+            what = "not a regular file" if path.exists() else "no such file"  # a FIFO, a folder
+            raise StimulusError(f"{text}: {what} {path_text}")
         module = _load_file(path)
         if not hasattr(module, attr):
             raise StimulusError(f"{text}: {path_text} defines no {attr!r}")

@@ -79,7 +79,8 @@ _WORDS = {"true": True, "1": True, "yes": True, "false": False, "0": False, "no"
 
 
 def _parse(key: str, text: str, bound: Bound) -> Any:
-    """A ``--set`` string as the type its key declares (a number, a whole number, a switch)."""
+    """A ``--set`` string as the type its key declares (a number, a whole number, a switch:
+    true / false, and the shell's yes / no and 1 / 0, which the message names too)."""
     if isinstance(bound, Range):
         try:
             return int(text) if bound.integer else float(text)
@@ -89,7 +90,7 @@ def _parse(key: str, text: str, bound: Bound) -> Any:
     if bound == FLAG:
         word = text.strip().lower()
         if word not in _WORDS:
-            raise ConfigError(f"{key}: expected true or false, got {text!r}")
+            raise ConfigError(f"{key}: expected true or false (or yes / no, 1 / 0), got {text!r}")
         return _WORDS[word]
     return text
 

@@ -34,7 +34,8 @@ def flatten(table: Mapping[str, Any], prefix: str = "") -> dict[str, Any]:
     """Nested TOML tables as dotted keys: ``{"pf": {"rho": 0.9}}`` -> ``{"pf.rho": 0.9}``.
 
     A key given twice (``"pf.rho" = 0.9`` beside ``[pf] rho = 0.8``) is a ConfigError, not
-    one value silently dropped.
+    one value silently dropped; so is an empty table inside (``[metrics] coverage = {}``, or
+    a ``[world]`` header with nothing under it), which would set nothing without a word.
 
     >>> flatten({"pf.rho": 0.9, "pf": {"rho": 0.8}})
     Traceback (most recent call last):
@@ -43,6 +44,9 @@ def flatten(table: Mapping[str, Any], prefix: str = "") -> dict[str, Any]:
     """
     flat: dict[str, Any] = {}
     for key, value in table.items():
+        if isinstance(value, Mapping) and not value:
+            raise ConfigError(f"{prefix}{key}: an empty table sets nothing; give a value "
+                              "(key = value) or remove it")
         inner = flatten(value, f"{prefix}{key}.") if isinstance(value, Mapping) else {
             f"{prefix}{key}": value}
         for name, item in inner.items():

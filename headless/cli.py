@@ -48,14 +48,15 @@ def _seed(text: str) -> int:
     """A ``--seed``: a whole number inside the declared seed range (``game.schema.SEED``)."""
     from game.schema import SEED
 
+    unit = "digits" if text.isdigit() else "characters"
+    shown = text if len(text) <= 30 else f"{text[:12]}…({len(text)} {unit})"
     try:
-        value = int(text)
+        value = int(text)  # beyond 4,300 digits a ValueError too (Python's own limit)
     except ValueError:
         raise argparse.ArgumentTypeError(
-            f"expected a whole number in {SEED.describe()}, got {text!r}") from None
+            f"expected a whole number in {SEED.describe()}, got {shown!r}") from None
     problem = SEED.problem(value)
     if problem is not None:
-        shown = str(value) if len(str(value)) <= 30 else f"{str(value)[:12]}…({len(str(value))} digits)"
         raise argparse.ArgumentTypeError(f"{shown} {problem}")
     return value
 
@@ -129,6 +130,8 @@ def _cmd_play(args: argparse.Namespace) -> int:
 
     from .outputs.clobber import level_file, plugin_files, refuse_inputs_all
 
+    if args.questions and args.record is None:
+        raise UsageError("--questions: the ratings are stored with the session: give --record DIR too")
     inputs = [level_file(args.level), args.config, *plugin_files(args.stimulus)]
     refuse_inputs_all("--screenshot/--record", [p for p in (args.screenshot, args.record) if p],
                       inputs)
@@ -153,6 +156,8 @@ def _cmd_replay(args: argparse.Namespace) -> int:
     if args.screenshot:
         refuse_inputs("--screenshot", args.screenshot, [
             args.trace, Path(args.trace) / STORE_NAME, level_file(args.level)])
+    if args.stimulus and args.trial is None:
+        raise UsageError("replay --stimulus: only with --trial KEY (a trace is replayed as written)")
     if args.trial is not None:
         from .reproduce import stored_spec, stored_trial
         from .sessions.record import session_trace
@@ -160,7 +165,7 @@ def _cmd_replay(args: argparse.Namespace) -> int:
         if stored_trial(args.trace, args.trial)["player"] == "human":  # a played session:
             args.trace = str(session_trace(args.trace, args.trial))  # its recorded trace
             return cmd_replay(args)
-        return replay_trial(stored_spec(args.trace, args.trial), args)
+        return replay_trial(stored_spec(args.trace, args.trial, args.stimulus), args)
     return cmd_replay(args)
 
 
@@ -363,7 +368,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--explain", action="store_true",
                    help="add the first guard's decision explained to each trace line "
                         "(to stderr when no --trace)")
-    add_stimulus(p, "add a stimulus")
+    add_stimulus(p, "add a stimulus (with --from: one the stored trial ran with, given again)")
     p.set_defaults(func=_cmd_sim)
 
     p = command("mechanics", "measured effects of the stealth mechanics (docs/mechanics.md)")
@@ -433,7 +438,8 @@ def build_parser() -> argparse.ArgumentParser:
                    help="let a player policy play (%(choices)s); a movement key takes over "
                         "(default: you play)")
     p.add_argument("--frames", type=int, default=None,
-                   help="stop after N frames, one physics step each (default: play until Esc)")
+                   help="stop after N frames, one physics step each (default: play until Esc); "
+                   "without a level the chooser, too, ends after N frames unless a level is chosen")
     p.add_argument("--screenshot", default=None, metavar="FILE.png",
                    help="save the last frame as PNG (default: none)")
     p.add_argument("--overlay", default="none",
@@ -451,7 +457,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--record", default=None, metavar="DIR",
                    help="store every game as a trial (player human) in the results store DIR")
     p.add_argument("--questions", action="store_true",
-                   help="with --record: ask three 1-5 ratings after each game")
+                   help="with --record (refused without it): ask three 1-5 ratings after each game")
     p.set_defaults(func=_cmd_play)
 
     p = command("replay", "replay a trace written by stealth sim --trace, or a stored trial")
@@ -470,6 +476,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--speed", type=float, default=1.0, help="playback speed factor")
     p.add_argument("--mesh", action="store_true", help="start with the grid / navmesh shown")
     p.add_argument("--plans", action="store_true", help="start with the guards' targets shown")
+    add_stimulus(p, "with --trial: a plugin stimulus the stored trial ran with, given again")
     p.set_defaults(func=_cmd_replay)
     return parser
 

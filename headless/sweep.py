@@ -160,6 +160,11 @@ def run_sweep(
     workers = check_workers(workers or os.cpu_count() or 1)
     if out.exists() and not out.is_dir():
         raise SweepError(f"--out {out}: exists and is not a directory")
+    from .tune.study_file import STUDY_FILE
+
+    if (out / STUDY_FILE).exists():  # the converse of tune's refusal of a results store
+        raise SweepError(f"--out {out}: holds a study ({STUDY_FILE} of stealth tune); a "
+                         "results store needs a directory of its own")
     store_path = out / STORE_NAME
     digests = level_digests(preset)
     _check_store(store_path, preset, digests)

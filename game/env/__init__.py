@@ -69,17 +69,20 @@ def check_action(space: spaces.Discrete, action: Any, who: str = "the agent") ->
     """``action`` as an int, or a ValueError naming it when it is not in ``space``.
 
     ``Discrete.contains`` refuses floats, strings and out-of-range integers (numpy's
-    ``-1`` included), so ``step(1.7)`` cannot silently become action 1.
+    ``-1`` included), so ``step(1.7)`` cannot silently become action 1; booleans (Python's
+    or numpy's, which ``contains`` takes) are refused here, so ``step(True)`` is not 1.
     """
     kind = type(action)
     if kind is int or kind is np.int64:  # the usual cases, without contains()'s dtype checks
         start = int(space.start)
         if start <= action < start + int(space.n):
             return int(action)
-    try:
-        ok = space.contains(action)
-    except (TypeError, ValueError):
-        ok = False
+    ok = False
+    if not isinstance(action, (bool, np.bool_)) and getattr(action, "dtype", None) != np.bool_:
+        try:
+            ok = space.contains(action)
+        except (TypeError, ValueError):
+            ok = False
     if not ok:
         raise ValueError(f"invalid action {action!r} for {who}: expected an integer in "
                          f"[0, {space.n - 1}] ({space})")
@@ -90,7 +93,10 @@ def _split_options(level: str, abstraction: str, scenario: str, kwargs: dict[str
                    ) -> tuple[dict[str, Any], dict[str, Any]]:
     """Env options and config overrides (``world__guards=2`` means ``world.guards=2``)."""
     options = {k: kwargs.pop(k) for k in _OPTIONS if k in kwargs}
-    overrides = dict(options.pop("overrides", None) or {})
+    given = options.pop("overrides", None)
+    if given is not None and not isinstance(given, Mapping):
+        raise ValueError(f"overrides must be a dict of config keys, not {given!r}")
+    overrides = dict(given or {})
     for key, value in kwargs.items():
         overrides[key.replace("__", ".")] = value
     return options, overrides
@@ -108,6 +114,8 @@ class StealthParallelEnv(ParallelEnv):
     def __init__(self, level: str = "miami", abstraction: str = "grid",
                  scenario: str = "capture", pad_observations: bool = True,
                  **config: Any) -> None:
+        if not isinstance(pad_observations, (bool, np.bool_)):
+            raise ValueError(f"pad_observations must be True or False, not {pad_observations!r}")
         options, overrides = _split_options(level, abstraction, scenario, config)
         self.match = Match(level, abstraction, scenario, None, overrides, **options)
         self.render_mode = self.match.render_mode
@@ -271,6 +279,11 @@ class StealthEnv(gymnasium.Env):
         self.match.close()
 
 
+#: The most worlds one :class:`StealthVectorEnv` steps in turn in one process (10^9 ran
+#: out of memory after 38 s); more belong in several processes.
+MAX_NUM_ENVS = 1024
+
+
 class StealthVectorEnv(gymnasium.vector.SyncVectorEnv):
     """``num_envs`` :class:`StealthEnv` worlds stepped in turn in this process.
 
@@ -282,8 +295,10 @@ class StealthVectorEnv(gymnasium.vector.SyncVectorEnv):
     """
 
     def __init__(self, num_envs: int = 1, **kwargs: Any) -> None:
-        if int(num_envs) < 1:
-            raise ValueError(f"num_envs must be >= 1, not {num_envs!r}")
+        if isinstance(num_envs, bool) or not isinstance(num_envs, (int, np.integer)) \
+                or not 1 <= num_envs <= MAX_NUM_ENVS:
+            raise ValueError(f"num_envs must be a whole number in [1, {MAX_NUM_ENVS}], "
+                             f"not {num_envs!r}")
         super().__init__([lambda: StealthEnv(**kwargs) for _ in range(int(num_envs))])
 
     def action_masks(self) -> np.ndarray:

@@ -24,7 +24,7 @@ from navmesh.level import cached_level
 from ..config import Config
 from .observations import OBS_BOUND, Observer
 from ..trial import TrialSpec, make_world
-from ..world import World
+from ..world import SCENARIOS, World
 
 __all__ = ["ExternalGuards", "ExternalPlayer", "GRID_ACTIONS", "Match", "PARTITION_ACTIONS",
            "REWARDS"]
@@ -79,6 +79,49 @@ def _direction_table(graph: NodeGraph) -> np.ndarray:
                     moves[node, a] = int(options[ok][np.argmax(along[ok])])
                     break
     return moves
+
+
+#: The largest ``obs_radius``: a window of 513 × 513 cells per channel (about 5 MB a
+#: guard's observation); a larger one would only pad a bundled level with zeros.
+MAX_OBS_RADIUS = 256
+#: The largest reward weight in absolute value: a 60-s return stays far from overflowing
+#: (1e308 per second survived made the reward inf).
+MAX_REWARD_WEIGHT = 1e6
+
+
+def _check_rewards(rewards: Any) -> None:
+    """Refuse ``rewards`` other than a dict of known terms to finite weights within
+    ±:data:`MAX_REWARD_WEIGHT` (a ValueError naming the term), at construction."""
+    if rewards is None:
+        return
+    if not isinstance(rewards, Mapping):
+        raise ValueError(f"rewards must be a dict of reward terms to weights, not {rewards!r}")
+    unknown = set(rewards) - set(REWARDS)
+    if unknown:
+        raise ValueError(f"unknown reward terms {sorted(unknown)} (choose from {list(REWARDS)})")
+    weights: dict[str, Any] = dict(rewards)
+    for term, weight in weights.items():
+        if isinstance(weight, bool) or not isinstance(weight, (int, float, np.integer, np.floating)) \
+                or not -MAX_REWARD_WEIGHT <= weight <= MAX_REWARD_WEIGHT:  # NaN fails it
+            raise ValueError(f"reward weight {term!r} must be a finite number in "
+                             f"[-{MAX_REWARD_WEIGHT:g}, {MAX_REWARD_WEIGHT:g}], not {weight!r}")
+
+
+def _render_size(size: Any) -> tuple[int, int]:
+    """``size`` as ``(width, height)`` of positive whole pixels, or a ValueError naming it.
+
+    Refused here, at construction, rather than inside pygame at the first ``render()``.
+    """
+    try:
+        width, height = size
+    except (TypeError, ValueError):
+        width = height = None
+    ok = all(isinstance(v, (int, np.integer)) and not isinstance(v, bool) and 0 < v <= 8192
+             for v in (width, height))
+    if not ok:
+        raise ValueError(f"render_size must be (width, height) in whole pixels in [1, 8192], "
+                         f"not {size!r}")
+    return int(width), int(height)
 
 
 class ExternalPlayer(PlayerPolicy):
@@ -146,9 +189,15 @@ class Match:
             raise ValueError(f"unknown abstraction {abstraction!r} (choose grid or partition)")
         if render_mode not in (None, "rgb_array", "human"):
             raise ValueError(f"unknown render_mode {render_mode!r} (choose rgb_array or human)")
-        unknown = set(rewards or {}) - set(REWARDS)
-        if unknown:
-            raise ValueError(f"unknown reward terms {sorted(unknown)} (choose from {list(REWARDS)})")
+        if scenario not in SCENARIOS:
+            raise ValueError(f"unknown scenario {scenario!r} (choose from {', '.join(SCENARIOS)})")
+        _check_rewards(rewards)
+        if isinstance(obs_radius, bool) or not isinstance(obs_radius, (int, np.integer)) \
+                or not 0 <= obs_radius <= MAX_OBS_RADIUS:
+            raise ValueError(f"obs_radius must be a whole number of cells in [0, {MAX_OBS_RADIUS}], "
+                             f"not {obs_radius!r}")
+        if render_size is not None:
+            render_size = _render_size(render_size)
         self.level = cached_level(level)
         self.abstraction, self.scenario, self.guard_mode = abstraction, scenario, guard_mode
         self.overrides = dict(overrides)
@@ -166,9 +215,13 @@ class Match:
             cfg[f"scenario.{scenario}.view_range_scale"])
         speed = float(cfg["world.player_speed"]) * float(
             cfg[f"scenario.{scenario}.player_speed_scale"])
-        #: physics steps a "stay" lasts: as long as a move along a mean edge takes
-        self.hold_steps = max(1, math.ceil(self.graph.mean_edge_length / speed / self.dt - 1e-9))
-        self.max_steps = max(self.hold_steps, math.ceil(2 * float(cfg["world.stuck_timeout"]) / self.dt))
+        #: physics steps a "stay" lasts: as long as a move along a mean edge takes, at most a
+        #: whole step's limit (a player too slow to cross an edge within it, e.g. a speed of
+        #: 5e-324, holds that long; the quotient itself may be infinite)
+        limit = math.ceil(2 * float(cfg["world.stuck_timeout"]) / self.dt)
+        hold = self.graph.mean_edge_length / speed / self.dt - 1e-9
+        self.hold_steps = max(1, math.ceil(hold)) if hold < limit else max(1, limit)
+        self.max_steps = max(self.hold_steps, limit)
         self.ends_on_capture = bool(cfg[f"scenario.{scenario}.end_on_capture"])
         #: node positions as Python floats (the same values as the graph's rows)
         self._points: list[list[float]] = self.graph.positions.tolist()
@@ -210,11 +263,19 @@ class Match:
         return self.info()
 
     def danger(self) -> float:
-        """The shaping potential now (negated): ``seen`` × seen + ``proximity`` × nearness."""
+        """The shaping potential now (negated): ``seen`` × seen + ``proximity`` × nearness.
+
+        Nearness falls linearly from 1 (a guard on the player's node) to 0 at the view
+        range; blind guards (view range 0) are near only on the player's node (the limit).
+        """
         r = self.rewards
         out = r["seen"] * bool(self.world.seen_by)
         if r["proximity"]:
-            out += r["proximity"] * max(0.0, 1.0 - self.guard_distance() / self.view_range)
+            distance = self.guard_distance()
+            if self.view_range > 0:
+                out += r["proximity"] * max(0.0, 1.0 - distance / self.view_range)
+            elif distance == 0:
+                out += r["proximity"]
         return out
 
     def info(self) -> dict[str, Any]:

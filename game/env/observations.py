@@ -65,6 +65,9 @@ class Observer:
         rows, cols = level.rows, level.cols
         cs = level.cell_size
         self.cell_size = cs
+        #: the length the player's guard offsets and move safety are measured in: the view
+        #: range, or one cell when the guards are blind (view range 0, docs/api.md)
+        self.range_unit = view_range if view_range > 0 else cs
         self.width, self.height = cols * cs, rows * cs
         self.diagonal = math.hypot(self.width, self.height)
         r = self.radius
@@ -153,7 +156,7 @@ class Observer:
             self._mark(win, 2, row, col, view.guard_positions[j])
         heading = world.player.heading
         vec = self._self_features(world, pos, heading, view) + [float(bool(view.seen_by))]
-        scale = self.view_range
+        scale = self.range_unit
         slots = []
         for j in known:
             d = view.guard_positions[j] - pos

@@ -79,9 +79,12 @@ def cmd_play(args: argparse.Namespace, on_session: SessionSink | None = None) ->
         pygame.display.set_caption("Stealthfield")
         chooser = LevelChooser(pygame.display.set_mode((960, 780)), bundled_level_names(),
                                mode=args.guards)
-        level = chooser.run()
+        level = chooser.run(args.frames)  # --frames: no choice within N frames ends play
         if level is None:
-            pygame.display.quit()
+            try:
+                finish(chooser.screen, args.screenshot, [])  # --screenshot: the chooser's frame
+            finally:
+                pygame.display.quit()
             return 0
         args.guards = chooser.mode
     settings = PlaySettings(

@@ -10,7 +10,9 @@ on the same level and seeds.
 
 from __future__ import annotations
 
+import os
 import re
+import sqlite3
 import sys
 from collections.abc import Mapping, Sequence
 from pathlib import Path
@@ -36,21 +38,48 @@ def session_trace(directory: str | Path, key: str) -> Path:
     return Path(directory) / "sessions" / f"{name}.jsonl"
 
 
+def _check_existing(directory: Path) -> None:
+    """Refuse, before a game is played, what would lose its session at the end: a
+    ``sessions`` that is not a folder, a store file that is not a regular SQLite file."""
+    sessions, store = directory / "sessions", directory / STORE_NAME
+    if (sessions.exists() or sessions.is_symlink()) and not sessions.is_dir():
+        raise UserError(f"--record {directory}: {sessions} is not a folder")
+    if not (store.exists() or store.is_symlink()):
+        return
+    if not store.is_file():
+        raise UserError(f"--record {directory}: {store} is not a regular file")
+    try:
+        with ResultStore(store, readonly=True):
+            pass
+    except sqlite3.DatabaseError as error:
+        raise UserError(f"--record {directory}: {store} is not a results store ({error})") from None
+
+
 class SessionStore:
     """Writes sessions (and their comparison trials) into one results directory."""
 
     def __init__(self, directory: str | Path, overrides: Sequence[str] = ()) -> None:
+        """Checks that ``directory`` can be made, and makes nothing: the folders come with
+        the first session, so a game refused (a bad key, a bad level) leaves no trace."""
         self.directory = Path(directory)
-        try:
-            self.directory.mkdir(parents=True, exist_ok=True)
-            (self.directory / "sessions").mkdir(exist_ok=True)
-        except OSError as error:
-            raise UserError(f"--record {directory}: cannot create the folder ({error})") from None
+        if self.directory.exists() and not self.directory.is_dir():
+            raise UserError(f"--record {directory}: not a folder")
+        parent = self.directory
+        while not parent.exists() and parent != parent.parent:
+            parent = parent.parent
+        if not parent.is_dir() or not os.access(parent, os.W_OK | os.X_OK):
+            raise UserError(f"--record {directory}: cannot create the folder "
+                            f"({parent} is not a writable folder)")
+        _check_existing(self.directory)
         self.overrides = tuple(overrides)
         self.stored: list[str] = []
 
     def __call__(self, row: Mapping[str, Any], trace: Sequence[str]) -> None:
         """Store one session row, its trace, and the comparison policies' trials."""
+        try:
+            (self.directory / "sessions").mkdir(parents=True, exist_ok=True)
+        except OSError as error:
+            raise UserError(f"--record {self.directory}: cannot create the folder ({error})") from None
         session_trace(self.directory, str(row["key"])).write_text(
             "".join(line + "\n" for line in trace), encoding="utf-8")
         with ResultStore(self.directory / STORE_NAME) as store:

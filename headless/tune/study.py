@@ -28,11 +28,12 @@ import math
 import os
 import sys
 import warnings
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
 from game.config_file import read_config_file, write_config_file
+from game.errors import ConfigError
 from game.trial import TrialSpec
 
 from ..errors import SweepError, UserError
@@ -44,7 +45,7 @@ from .objective import as_trials
 from .spec import TuneSpec, load_tune_spec
 from .study_file import STUDY_FILE, check_study_file, study_errors
 
-__all__ = ["cmd_tune", "run_study"]
+__all__ = ["MAX_STUDY_TRIALS", "check_study_budget", "cmd_tune", "run_study"]
 
 STUDY_NAME = "stealth-tune"
 # --------------------------------------------------------------------------- evaluation
@@ -201,10 +202,49 @@ def _failed(count: int, number: int, why: str, stream: Any) -> int:
     return count + 1
 
 
+MAX_STUDY_TRIALS = 10_000
+"""Most Optuna trials one study may ask for (``--trials``): the bundled designer-pf study
+(100 trials of 1,200 steps per Optuna trial) fits the step budget 16,000 times."""
+
+
+def _worst(spec: TuneSpec, key: str, config: Mapping[str, Any], largest: bool) -> Any:
+    """The largest (or smallest) value ``key`` takes in the study: its search range's end
+    or choice when it is searched, else the design's value."""
+    for p in spec.params:
+        if p.key == key:
+            values = [float(v) for v in (p.choices if p.choices else (p.low, p.high))]
+            return max(values) if largest else min(values)
+    return config[key]
+
+
+def check_study_budget(spec: TuneSpec, trials: int) -> None:
+    """Refuse a study whose ``trials`` × physics steps exceed the sweeps' budget (:func:`game.budget.check_design_steps`: every Optuna
+    trial runs the design on the training seeds, the best one the test seeds); a searched
+    ``world.duration`` or ``world.physics_step`` counts at its costliest end."""
+    from game.budget import check_design_steps
+    from game.config import Config
+
+    preset = spec.preset
+    config = Config.load(dict(preset.overrides)).as_dict()
+    config["world.duration"] = _worst(spec, "world.duration", config, largest=True)
+    config["world.physics_step"] = _worst(spec, "world.physics_step", config, largest=False)
+    per_cell = trials * spec.seeds_train + spec.seeds_test
+    cells = preset.n_trials // len(preset.seeds)  # level × abstraction × ... × factor levels
+    try:  # check_design_steps multiplies by the factor levels itself
+        check_design_steps(cells // math.prod(len(v) for _, v in preset.factors) * per_cell,
+                           config, preset.factors)
+    except ConfigError as error:
+        count = f"the study's {per_cell * cells:,} trials"
+        raise UserError(f"--trials {trials}: " + str(error).replace(
+            "the design's trials", count).replace("use fewer seeds", "use fewer --trials, seeds")
+                        ) from None
+
+
 def cmd_tune(args: argparse.Namespace) -> int:
     """``stealth tune SPEC.toml --out DIR [--trials N] [--workers N] [--config FILE]``."""
-    if args.trials < 1:
-        raise UserError(f"--trials: must be at least 1, got {args.trials}")
+    if not 1 <= args.trials <= MAX_STUDY_TRIALS:
+        raise UserError(f"--trials: expected a number of trials in [1, {MAX_STUDY_TRIALS}], "
+                        f"got {args.trials}")
     if args.workers is not None and args.workers < 1:
         raise UserError(f"--workers: must be at least 1, got {args.workers}")
     from ..outputs.clobber import refuse_inputs_all
@@ -213,8 +253,14 @@ def cmd_tune(args: argparse.Namespace) -> int:
         "best.toml", "study.csv", "report.md", "history.png", "params.png", "results.lock")],
                       [args.spec, args.config])
     extra = read_config_file(args.config) if args.config else None
-    spec = load_tune_spec(args.spec, extra)
     out = Path(args.out)
+    from ..store import STORE_NAME
+
+    if (out / STORE_NAME).exists():
+        raise UserError(f"--out {out}: holds a results store ({STORE_NAME} of stealth run); "
+                        "a study needs a directory of its own")
+    spec = load_tune_spec(args.spec, extra)
+    check_study_budget(spec, args.trials)
     run_study(spec, out, args.trials, workers=args.workers, scheduler=args.scheduler)
     print(f"stealth: study in {out}: best.toml, study.csv, report.md", file=sys.stderr)
     return 0
