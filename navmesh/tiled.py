@@ -46,7 +46,7 @@ from shapely.geometry import Polygon, box
 from navmesh.errors import LevelError, LevelWarning
 from navmesh.level_fields import zone_kinds
 from navmesh.level_format import Level, parse_level
-from navmesh.tiled_guard import check_map_cells, guard_json_map
+from navmesh.tiled_guard import MapFiles, check_map_cells
 from navmesh.tiled_read import read_map
 
 __all__ = ["ELLIPSE_SIDES", "load_tiled", "tiled_level_data"]
@@ -77,16 +77,18 @@ class _Collected:
     layer: an infinite map's extent when it has no walls, obstacles or outline."""
 
 
-def load_tiled(path: Path, source: str, digest: str | None = None) -> Level:
+def load_tiled(path: Path, source: str, digest: str | None = None,
+               raw: bytes | None = None) -> Level:
     """Read a Tiled map and validate it as a level; errors name the Tiled layer or object.
 
-    ``digest`` is the content identity of the file (see :func:`navmesh.level.cached_level`).
+    ``raw`` is the map's bytes if the caller has read them (else they are read here, bounded);
+    ``digest`` is their content identity (see :func:`navmesh.level.cached_level`).
     The map's :class:`~navmesh.errors.LevelWarning` lines are issued only if it loads: a
     refused map is its one error line.
     """
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always", LevelWarning)
-        data, origins = tiled_level_data(path, source)
+        data, origins = tiled_level_data(path, source, raw)
         try:
             level = parse_level(data, source, path=path, digest=digest, require_guards=False)
         except LevelError as exc:
@@ -96,13 +98,16 @@ def load_tiled(path: Path, source: str, digest: str | None = None) -> Level:
     return level
 
 
-def tiled_level_data(path: Path, source: str) -> tuple[dict[str, Any], dict[str, str]]:
+def tiled_level_data(path: Path, source: str, raw: bytes | None = None
+                     ) -> tuple[dict[str, Any], dict[str, str]]:
     """The SPEC §8 level structure of a Tiled map, and where each of its entries came from.
 
     The second value maps a field of the structure (``"guards[1]"``, ``"obstacles[0]"``,
     ``"grid"``, ...) to the Tiled layer or object it was made from.
     """
-    tmap = _read_map(path, source)
+    if raw is None:
+        raw = MapFiles(source).read(path, "map")
+    tmap = _read_map(path, raw, source)
     if tmap.orientation != "orthogonal":
         _fail(source, "map", f"orientation {tmap.orientation!r} is not supported; "
                              "only orthogonal maps are")
@@ -188,18 +193,17 @@ def tiled_level_data(path: Path, source: str) -> tuple[dict[str, Any], dict[str,
 # --------------------------------------------------------------------------- reading
 
 
-def _read_map(path: Path, source: str) -> pytiled_parser.TiledMap:
+def _read_map(path: Path, raw: bytes, source: str) -> pytiled_parser.TiledMap:
     """Read with :func:`navmesh.tiled_read.read_map`; any failure becomes a one-line LevelError.
 
     The reader signals malformed input with whatever its code happens to raise (KeyError for
-    a missing key, TypeError, ValueError, NotImplementedError for TMX templates, OSError for
-    a missing tileset file, ...), so everything it raises is caught here and reported with
+    a missing key, TypeError, ValueError, RecursionError for layers nested too deep, ...),
+    so everything it raises is caught here and reported with
     its type: the map is user input and must never end in a traceback. The files it names
     and its layers' data are bounded first (:mod:`navmesh.tiled_guard`).
     """
-    guard_json_map(path, source)
     try:
-        return read_map(path, source)
+        return read_map(path, raw, source)
     except LevelError:
         raise
     except KeyError as exc:
