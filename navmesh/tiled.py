@@ -208,8 +208,9 @@ def _read_map(path: Path, raw: bytes, source: str) -> pytiled_parser.TiledMap:
         raise
     except KeyError as exc:
         _fail(source, "map", f"not a Tiled map Stealthfield can read: missing key {exc}")
-    except FileNotFoundError as exc:
-        _fail(source, "map", f"a file the map refers to is missing: {exc.filename}")
+    except RecursionError:
+        _fail(source, "map", "not a Tiled map Stealthfield can read: nested too deeply "
+                             "(RecursionError)")
     except Exception as exc:  # noqa: BLE001 - third-party reader, see the docstring
         _fail(source, "map", f"not a Tiled map Stealthfield can read: "
                              f"{type(exc).__name__}: {exc}")
@@ -316,13 +317,16 @@ def _object_geometry(
     if isinstance(obj, to.Polyline):
         _fail(src, where, "a polyline is not closed; use a polygon object")
     x, y = float(obj.coordinates.x) + ox, float(obj.coordinates.y) + oy
+    _finite(src, where, "position", x, y)
     if isinstance(obj, to.Point):
         if want_area:
             _fail(src, where, "a point object has no area; use a rectangle, polygon or ellipse")
         return shapely.Point(x, y)
     w, h = float(obj.size.width), float(obj.size.height)
+    _finite(src, where, "size and rotation", w, h, float(obj.rotation))
     if isinstance(obj, to.Polygon):
-        local = np.array([(float(p.x), float(p.y)) for p in obj.points])
+        local = np.array([(float(p.x), float(p.y)) for p in obj.points]).reshape(-1, 2)
+        _finite(src, where, "points", *local.ravel())
     elif isinstance(obj, to.Ellipse):
         angles = 2.0 * np.pi * np.arange(ELLIPSE_SIDES) / ELLIPSE_SIDES
         local = np.column_stack([w / 2 * (1 + np.cos(angles)), h / 2 * (1 + np.sin(angles))])
@@ -340,7 +344,9 @@ def _object_geometry(
     cos, sin = math.cos(theta), math.sin(theta)
     if theta:
         local = local @ np.array([[cos, sin], [-sin, cos]])
-    polygon = Polygon(local + (x, y))
+    corners = local + (x, y)
+    _finite(src, where, "corners (position + size)", *corners.ravel())
+    polygon = Polygon(corners)
     if not want_area:
         if not polygon.is_valid or polygon.area <= 0:
             _fail(src, where, "shape is not a simple polygon, so it has no centre")
@@ -461,6 +467,13 @@ def _origin(fld: str, origins: dict[str, str]) -> str:
     best = max((k for k in origins if fld == k or fld.startswith(k + "[")
                 or fld.startswith(k + ".")), key=len, default=None)
     return origins[best] if best is not None else fld
+
+
+def _finite(src: str, where: str, what: str, *values: float) -> None:
+    """A Tiled object's numbers must be finite (a TMX ``x="nan"`` or a JSON ``NaN``)."""
+    bad = next((v for v in values if not math.isfinite(v)), None)
+    if bad is not None:
+        _fail(src, where, f"{what} must be finite numbers, got {bad:g}")
 
 
 def _fail(src: str, fld: str, problem: str) -> NoReturn:

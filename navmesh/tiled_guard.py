@@ -47,6 +47,7 @@ MAX_NAMED_FILES = 1000
 MAX_COORDINATE = 2**31
 """Bound of a chunk's tile coordinates and a layer's pixel offsets (Tiled's are 32-bit)."""
 
+_OBJECT_DEFAULTS = {"name": "", "visible": True, "rotation": 0, "width": 0, "height": 0}
 _GID_END = 2**32  # a gid is an unsigned 32-bit number (flip flags in its top bits)
 
 
@@ -75,6 +76,8 @@ class MapFiles:
             _fail(self.source, where, f"a file the map refers to is missing: {path}")
         except OSError as exc:
             _fail(self.source, where, f"cannot read {path} ({exc.strerror or exc})")
+        except ValueError as exc:  # a NUL byte in the name
+            _fail(self.source, where, f"cannot read {str(path)!r} ({exc})")
         self._total += len(raw)
         if self._total > MAX_FILE_BYTES:
             _fail(self.source, where, f"the files the map names hold more than "
@@ -131,14 +134,15 @@ def check_coordinates(source: str, where: str, what: str, *values: Any,
                                  f"{value!r}")
 
 
-def check_gids(gids: list[Any], tiles: int, source: str, where: str) -> None:
-    """``gids`` (CSV or a JSON list) must be exactly ``tiles`` integers in [0, 2^32)."""
-    if len(gids) != tiles:
-        _fail(source, where, f"tile data holds {len(gids)} gids, expected {tiles} (one per "
-                             "tile of the layer's width × height)")
+def check_gids(gids: list[Any], width: int, height: int, source: str, where: str) -> None:
+    """``gids`` (CSV or a JSON list) must be exactly width × height integers in [0, 2^32)."""
+    if len(gids) != width * height:
+        _fail(source, where, f"tile data holds {len(gids)} gids, expected {width * height} "
+                             f"(one per tile of {width}x{height})")
     for i, gid in enumerate(gids):
         if isinstance(gid, bool) or not isinstance(gid, int) or not 0 <= gid < _GID_END:
-            _fail(source, where, f"gid {i} is {gid!r}, not a whole number in [0, {_GID_END})")
+            _fail(source, where, f"the gid of the tile at row {i // width}, column "
+                                 f"{i % width} is {gid!r}, not a whole number in [0, 2^32)")
 
 
 def check_encoded(data: Any, compression: str, tiles: int, source: str, where: str) -> None:
@@ -183,7 +187,11 @@ def _guard_json(doc: dict[str, Any], folder: Path, templates: Templates) -> None
         objects = _list(layer.get("objects"))
         for i, obj in enumerate(objects):
             if isinstance(obj, dict) and "template" in obj:
-                objects[i] = templates.inline_json(obj, folder, f"{where} object {obj.get('id')}")
+                objects[i] = obj = templates.inline_json(obj, folder,
+                                                         f"{where} object {obj.get('id')}")
+            if isinstance(obj, dict):  # keys every Tiled writes, which older ones left out
+                for key, value in _OBJECT_DEFAULTS.items():
+                    obj.setdefault(key, value)
 
 
 def _guard_json_tiles(layer: dict[str, Any], where: str, source: str,
@@ -200,7 +208,7 @@ def _guard_json_tiles(layer: dict[str, Any], where: str, source: str,
         if encoding:
             check_encoded(data, str(compression or ""), width * height, source, where)
         elif isinstance(data, list):
-            check_gids(data, width * height, source, where)
+            check_gids(data, width, height, source, where)
         else:
             _fail(source, where, f"tile data must be a list of gids, got {type(data).__name__}")
 
@@ -292,7 +300,7 @@ def _guard_xml_tiles(layer: Any, where: str, source: str, chunks: ChunkTally) ->
                 element.remove(tile)
         text = (element.text or "").strip()
         values = [v.strip() for v in text.split(",")] if text else []
-        check_gids([_whole(v) for v in values], width * height, source, where)
+        check_gids([_whole(v) for v in values], width, height, source, where)
         element.text = text or "0"  # pytiled-parser reads no text as an error; 0 is no tile
 
     found = data.findall("chunk")

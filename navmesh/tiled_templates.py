@@ -95,7 +95,10 @@ class Templates:
         return self._decoded[path]
 
     def _decode(self, path: Path, raw: bytes, field: str, xml: bool) -> Any:
-        if is_tiled_xml(raw) != xml:
+        if not raw.strip():
+            self._fail(field, f"{path} is empty")
+        looks_json = raw.lstrip(b"\xef\xbb\xbf \t\r\n")[:1] == b"{"
+        if (is_tiled_xml(raw) and not xml) or (looks_json and xml):
             kind, wanted = ("JSON (.tj)", "TMX (.tx)") if xml else ("TMX (.tx)", "JSON (.tj)")
             self._fail(field, f"{path} is a {kind} template; a {'TMX' if xml else 'JSON'} map "
                               f"reads {wanted} templates (save it in that format in Tiled)")
