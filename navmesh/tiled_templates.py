@@ -5,14 +5,16 @@ in JSON) stores only its id, position and what it overrides; the rest is in the 
 Tiled's rule is applied here, on the decoded map: the object's own attributes win,
 properties are merged by name (the object's value wins), and the template's shape is kept
 unless the object has its own. pytiled-parser, which would open the template and its
-tileset with a plain :func:`open`, then sees ordinary objects and opens nothing.
+tileset with a plain :func:`open`, then sees ordinary objects and opens nothing. As in
+Tiled, a map of either format may use templates of either format (``.tx`` or ``.tj``): a
+template in the other format is converted (its attributes, shape and scalar properties;
+class-typed properties, which a level never reads, are left out).
 
 Each template and its tileset are read through :class:`navmesh.tiled_guard.MapFiles`, so a
 FIFO, a device or a huge file is refused like any file a map names; the tileset is only
 checked, never parsed (a level needs no tile images). Every placed object counts its
 template's size against :data:`navmesh.level_fields.MAX_FILE_BYTES`, so a small map cannot
-multiply a large template into unbounded work. A template of the other format than its map
-(a ``.tx`` in a JSON map, a ``.tj`` in a TMX map) is refused in one line.
+multiply a large template into unbounded work.
 """
 
 from __future__ import annotations
@@ -97,11 +99,16 @@ class Templates:
     def _decode(self, path: Path, raw: bytes, field: str, xml: bool) -> Any:
         if not raw.strip():
             self._fail(field, f"{path} is empty")
-        looks_json = raw.lstrip(b"\xef\xbb\xbf \t\r\n")[:1] == b"{"
-        if (is_tiled_xml(raw) and not xml) or (looks_json and xml):
-            kind, wanted = ("JSON (.tj)", "TMX (.tx)") if xml else ("TMX (.tx)", "JSON (.tj)")
-            self._fail(field, f"{path} is a {kind} template; a {'TMX' if xml else 'JSON'} map "
-                              f"reads {wanted} templates (save it in that format in Tiled)")
+        template = self._decode_format(path, raw, field, is_tiled_xml(raw))
+        if is_tiled_xml(raw) == xml:
+            return template
+        try:
+            return _xml_object(template) if xml else _json_object(template)
+        except (TypeError, ValueError, AttributeError, KeyError) as exc:
+            self._fail(field, f"{path} cannot be converted to the map's format "
+                              f"({type(exc).__name__}: {exc})")
+
+    def _decode_format(self, path: Path, raw: bytes, field: str, xml: bool) -> Any:
         if xml:
             try:
                 root = etree.fromstring(raw)
@@ -131,3 +138,63 @@ class Templates:
 
     def _fail(self, field: str, problem: str) -> NoReturn:
         raise LevelError(self.files.source, field, problem)
+
+
+# --------------------------------------------------------------------------- conversion
+
+_NUMBERS = {"x": float, "y": float, "width": float, "height": float, "rotation": float,
+            "gid": int, "id": int}
+_SCALARS = {"int": int, "float": float, "bool": lambda v: v == "true"}
+
+
+def _json_object(element: Any) -> dict[str, Any]:
+    """A TMX template's ``<object>`` as the JSON object Tiled would have written."""
+    obj: dict[str, Any] = {}
+    for key, value in element.attrib.items():
+        if key == "visible":
+            obj[key] = value != "0"
+        else:
+            obj[key] = _NUMBERS.get(key, str)(value)
+    for child in element:
+        if child.tag in ("point", "ellipse"):
+            obj[child.tag] = True
+        elif child.tag in ("polygon", "polyline"):
+            pairs = [p.split(",") for p in (child.get("points") or "").split()]
+            obj[child.tag] = [{"x": float(x), "y": float(y)} for x, y in pairs]
+        elif child.tag == "text":
+            obj["text"] = {**child.attrib, "text": child.text or ""}
+        elif child.tag == "properties":
+            obj["properties"] = [
+                {"name": p.get("name"), "type": p.get("type", "string"),
+                 "value": _SCALARS.get(p.get("type", ""), str)(p.get("value", p.text or ""))}
+                for p in child if p.get("type") != "class"]
+    return obj
+
+
+def _xml_object(obj: dict[str, Any]) -> Any:
+    """A JSON template's object as the TMX ``<object>`` Tiled would have written."""
+    element = etree.Element("object")
+    for key, value in obj.items():
+        if isinstance(value, bool):
+            if key == "visible":
+                element.set(key, "1" if value else "0")
+            elif key in ("point", "ellipse") and value:
+                etree.SubElement(element, key)
+        elif key in ("polygon", "polyline"):
+            points = " ".join(f"{p['x']},{p['y']}" for p in value)
+            etree.SubElement(element, key, points=points)
+        elif key == "text" and isinstance(value, dict):
+            text = etree.SubElement(element, "text", {k: str(v) for k, v in value.items()
+                                                      if k != "text"})
+            text.text = str(value.get("text", ""))
+        elif key == "properties" and isinstance(value, list):
+            holder = etree.SubElement(element, "properties")
+            for p in value:
+                if p.get("type") != "class":
+                    shown = str(p.get("value")).lower() if isinstance(p.get("value"), bool) \
+                        else str(p.get("value"))
+                    etree.SubElement(holder, "property", name=str(p.get("name")),
+                                     type=str(p.get("type", "string")), value=shown)
+        elif isinstance(value, (int, float, str)):
+            element.set(key, str(value))
+    return element

@@ -403,7 +403,7 @@ def _bad_maps(w: MapWriter) -> list[tuple[str, dict, str]]:
          "layer 'things' object 98 template: a file the map refers to is missing: .*nowhere.tj"),
         ("tmx template", w.map(20, 20, objs(guard(), {"id": 99, "template": "guard.tx",
                                                      "x": 48, "y": 48})),
-         r"object 99 template: .*guard.tx is a TMX \(.tx\) template; a JSON map reads JSON"),
+         r"object 99 template: .*guard.tx is not an object template \(no <template> holding"),
         ("infinite, empty", w.map(20, 20, [w.objects("o", [guard()])], infinite=True),
          "map: an infinite map without tiles, obstacles or an outline object has no extent"),
     ]

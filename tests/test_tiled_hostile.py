@@ -246,11 +246,21 @@ def test_templates_are_merged_as_tiled_does(tmp_path):
     assert level.guards == ((1.5, 1.5),) and level.decoys == ((9.5, 1.5),)
 
 
-def test_a_template_of_the_other_format_is_refused_in_one_line(tmp_path, capsys):
-    tsx(tmp_path)
+def test_a_template_of_the_other_format_is_converted(tmp_path, capsys):
+    """As in Tiled, a TMX map may place ``.tj`` templates and a JSON map ``.tx`` ones."""
     tj(tmp_path)
-    refused(tmx(tmp_path, objects=GUARD + placed("guard.tj")),
-            "guard.tj is a JSON (.tj) template; a TMX map reads TMX (.tx) templates", capsys)
+    tx(tmp_path, obj='<object type="dark" width="64" height="32" rotation="90"><properties>'
+                     '<property name="n" type="int" value="3"/></properties></object>')
+    level = load_level(tmx(tmp_path, objects=GUARD + placed("guard.tj")))
+    assert level.guards == ((1.5, 1.5), (9.5, 1.5))
+    level = load_level(tmj(tmp_path, [placed_json("guard.tj", 3, 48, 48),
+                                      placed_json("guard.tx", 5, 96, 288)]))
+    (zone,) = level.zones["dark"]
+    assert zone.bounds == pytest.approx((2.0, 9.0, 3.0, 11.0))  # turned 90° about (3, 9)
+    tx(tmp_path, name="bad.tx", obj='<object type="dark"><polygon points="1,2,3"/></object>')
+    refused(tmj(tmp_path, [placed_json("guard.tj", 3, 48, 48), placed_json("bad.tx")]),
+            "object 4 template: ", capsys)
+    assert "bad.tx cannot be converted to the map's format" in str(_error(tmp_path / "map.tmj"))
 
 
 def test_the_files_a_map_names_are_bounded_together(tmp_path, capsys, monkeypatch):
