@@ -22,7 +22,7 @@ from __future__ import annotations
 import json
 import xml.etree.ElementTree as etree
 from pathlib import Path
-from typing import TYPE_CHECKING, Any, NoReturn
+from typing import TYPE_CHECKING, Any, Callable, NoReturn
 
 from navmesh.errors import LevelError
 from navmesh.level_fields import MAX_FILE_BYTES
@@ -142,9 +142,11 @@ class Templates:
 
 # --------------------------------------------------------------------------- conversion
 
-_NUMBERS = {"x": float, "y": float, "width": float, "height": float, "rotation": float,
-            "gid": int, "id": int}
-_SCALARS = {"int": int, "float": float, "bool": lambda v: v == "true"}
+_NUMBERS: dict[str, Callable[[str], Any]] = {
+    "x": float, "y": float, "width": float, "height": float, "rotation": float, "gid": int,
+    "id": int}
+_SCALARS: dict[str, Callable[[str], Any]] = {"int": int, "float": float,
+                                             "bool": lambda v: v == "true"}
 
 
 def _json_object(element: Any) -> dict[str, Any]:
