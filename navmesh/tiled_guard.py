@@ -1,4 +1,4 @@
-"""Bounds on a Tiled map, checked on its decoded document before pytiled-parser reads it (SPEC §8, §10).
+"""Bounds on a Tiled map, checked on the decoded map before pytiled-parser reads it (SPEC §10).
 
 pytiled-parser opens every file a map names (object templates and their tilesets) with a
 plain :func:`open`, inflates every compressed layer whole and takes tile data of any length,

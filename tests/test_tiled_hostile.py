@@ -144,7 +144,8 @@ class _Recorder:
 def _every_feature(folder: Path, kind: str) -> tuple[Path, set[str]]:
     """A map using external tilesets, templates with tilesets, an image layer and a tile
     object; the files the loader must read."""
-    image = ' <imagelayer id="3" name="sky"><image source="sky.png" width="9" height="9"/></imagelayer>\n'
+    image = (' <imagelayer id="3" name="sky"><image source="sky.png" width="9" height="9"/>'
+             '</imagelayer>\n')
     if kind == "tmx":
         tsx(folder)
         tsx(folder, "props.tsx")
@@ -299,7 +300,8 @@ def test_a_tmj_object_at_nan_and_a_polygon_point_at_nan(tmp_path, capsys):
     refused(tmj(tmp_path, [guard]), "object 3 (guard): position must be finite numbers",
             capsys)
     tsx(tmp_path)
-    polygon = '<object id="4" type="dark" x="48" y="48"><polygon points="0,0 nan,0 0,32"/></object>'
+    polygon = ('<object id="4" type="dark" x="48" y="48">'
+               '<polygon points="0,0 nan,0 0,32"/></object>')
     refused(tmx(tmp_path, objects=GUARD + polygon), "points must be finite numbers", capsys)
 
 
