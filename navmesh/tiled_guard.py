@@ -216,11 +216,19 @@ def _guard_json_tiles(layer: dict[str, Any], where: str, source: str,
         size = _required_size(layer, source, where)
         check_map_cells(*size, source, where)
         check(layer["data"], *size)
+        if 0 in size:  # no tiles: pytiled-parser would divide by the width
+            del layer["data"]
+    kept = []
     for chunk in _list(layer.get("chunks")):
         if isinstance(chunk, dict):
             size = _required_size(chunk, source, f"{where} chunk")
             chunks.add(*size, chunk.get("x"), chunk.get("y"), source, where)
             check(chunk.get("data"), *size)
+            if 0 in size:
+                continue
+        kept.append(chunk)
+    if "chunks" in layer and isinstance(layer["chunks"], list):
+        layer["chunks"] = kept
 
 
 def _json_layers(layers: list[Any], parent: str) -> Any:
@@ -301,17 +309,22 @@ def _guard_xml_tiles(layer: Any, where: str, source: str, chunks: ChunkTally) ->
         text = (element.text or "").strip()
         values = [v.strip() for v in text.split(",")] if text else []
         check_gids([_whole(v) for v in values], width, height, source, where)
-        element.text = text or "0"  # pytiled-parser reads no text as an error; 0 is no tile
 
     found = data.findall("chunk")
     if not found:
         size = _xml_required(layer, source, where)
         check_map_cells(*size, source, where)
         check(data, *size)
+        if 0 in size:  # no tiles: pytiled-parser would divide by the width
+            layer.remove(data)
     for chunk in found:
         size = _xml_required(chunk, source, f"{where} chunk")
         chunks.add(*size, chunk.get("x"), chunk.get("y"), source, where)
         check(chunk, *size)
+        if 0 in size:
+            data.remove(chunk)
+    if found and data.find("chunk") is None:
+        layer.remove(data)
 
 
 def _xml_layers(parent: Any, prefix: str) -> Any:

@@ -351,6 +351,14 @@ def test_layer_data_of_the_wrong_length_or_values_is_refused(tmp_path, capsys, k
     refused(path, message, capsys)
 
 
+def test_a_layer_or_chunk_of_no_tiles_is_read_as_empty(tmp_path):
+    empty = '<layer id="7" name="empty" width="0" height="0"><data encoding="csv"></data></layer>'
+    assert load_level(tmx(tmp_path, extra=empty)).occupancy.sum() == 206  # walkable cells
+    chunks = ('<data encoding="csv"><chunk x="0" y="0" width="0" height="3"></chunk>'
+              f'<chunk x="0" y="0" width="20" height="20">{_csv(GIDS)}</chunk></data>')
+    assert load_level(tmx(tmp_path, data=chunks, infinite=True)).occupancy.sum() == 206  # walkable cells
+
+
 def test_a_tileset_is_checked_not_parsed(tmp_path):
     """100,000 collision shapes in a tileset tile cost nothing: tilesets are never parsed."""
     shapes = "".join(f'<object id="{i}" x="0" y="0" width="1" height="1"/>'
