@@ -352,11 +352,12 @@ def test_layer_data_of_the_wrong_length_or_values_is_refused(tmp_path, capsys, k
 
 
 def test_a_layer_or_chunk_of_no_tiles_is_read_as_empty(tmp_path):
+    """The maze's 206 walkable cells, whatever empty layers and chunks lie beside it."""
     empty = '<layer id="7" name="empty" width="0" height="0"><data encoding="csv"></data></layer>'
-    assert load_level(tmx(tmp_path, extra=empty)).occupancy.sum() == 206  # walkable cells
+    assert load_level(tmx(tmp_path, extra=empty)).occupancy.sum() == 206
     chunks = ('<data encoding="csv"><chunk x="0" y="0" width="0" height="3"></chunk>'
               f'<chunk x="0" y="0" width="20" height="20">{_csv(GIDS)}</chunk></data>')
-    assert load_level(tmx(tmp_path, data=chunks, infinite=True)).occupancy.sum() == 206  # walkable cells
+    assert load_level(tmx(tmp_path, data=chunks, infinite=True)).occupancy.sum() == 206
 
 
 def test_a_tileset_is_checked_not_parsed(tmp_path):
