@@ -15,7 +15,9 @@ rules as every other input:
 * each layer's or chunk's data holds exactly width × height gids, each in [0, 2^32): base64
   is inflated by :func:`navmesh.files.inflate_bounded` against width × height × 4 bytes;
   TMX's old ``<tile gid="…"/>`` form is rewritten as the CSV it means;
-* sizes meet the cell limit and chunk coordinates and layer offsets lie within ±2^31.
+* sizes meet the cell limit and chunk coordinates and layer offsets lie within ±2^31; a
+  layer or chunk of no tiles is dropped (pytiled-parser would divide by its zero width), and
+  a JSON object gets the keys every Tiled writes (``name``, ``visible``, ...) if it lacks them.
 
 A map that passes is one pytiled-parser reads in bounded time and memory.
 """
@@ -108,7 +110,7 @@ def check_map_cells(width: int, height: int, source: str, what: str = "map") -> 
                             f"limit of {MAX_CELLS} cells")
 
 
-class ChunkTally:
+class _ChunkTally:
     """The tiles of an infinite map's chunks, counted against :data:`MAX_CHUNK_CELLS`."""
 
     def __init__(self) -> None:
@@ -116,13 +118,13 @@ class ChunkTally:
 
     def add(self, width: int, height: int, x: Any, y: Any, source: str, where: str) -> None:
         check_map_cells(width, height, source, where)
-        check_coordinates(source, where, "chunk position", x, y, integer=True)
+        _check_coordinates(source, where, "chunk position", x, y, integer=True)
         self.cells += width * height
         if self.cells > MAX_CHUNK_CELLS:
             _fail(source, where, f"chunks of more than {MAX_CHUNK_CELLS} tiles in all")
 
 
-def check_coordinates(source: str, where: str, what: str, *values: Any,
+def _check_coordinates(source: str, where: str, what: str, *values: Any,
                       integer: bool = False) -> None:
     """Finite numbers within ±:data:`MAX_COORDINATE` (whole ones if ``integer``)."""
     for value in values:
@@ -134,7 +136,7 @@ def check_coordinates(source: str, where: str, what: str, *values: Any,
                                  f"{value!r}")
 
 
-def check_gids(gids: list[Any], width: int, height: int, source: str, where: str) -> None:
+def _check_gids(gids: list[Any], width: int, height: int, source: str, where: str) -> None:
     """``gids`` (CSV or a JSON list) must be exactly width × height integers in [0, 2^32)."""
     if len(gids) != width * height:
         _fail(source, where, f"tile data holds {len(gids)} gids, expected {width * height} "
@@ -145,7 +147,7 @@ def check_gids(gids: list[Any], width: int, height: int, source: str, where: str
                                  f"{i % width} is {gid!r}, not a whole number in [0, 2^32)")
 
 
-def check_encoded(data: Any, compression: str, tiles: int, source: str, where: str) -> None:
+def _check_encoded(data: Any, compression: str, tiles: int, source: str, where: str) -> None:
     """Base64 tile data (optionally compressed) must hold exactly ``tiles`` 4-byte gids."""
     if not isinstance(data, str):
         _fail(source, where, f"base64 tile data must be a string, got {type(data).__name__}")
@@ -177,10 +179,10 @@ def _guard_json(doc: dict[str, Any], folder: Path, templates: Templates) -> None
     for i, tileset in enumerate(_list(doc.get("tilesets"))):
         if isinstance(tileset, dict) and isinstance(tileset.get("source"), str):
             files.read(folder / tileset["source"], f"tilesets[{i}].source")
-    chunks = ChunkTally()
+    chunks = _ChunkTally()
     for name, layer in _json_layers(_list(doc.get("layers")), ""):
         where = f"layer {name!r}"
-        check_coordinates(source, where, "offset", layer.get("offsetx", 0),
+        _check_coordinates(source, where, "offset", layer.get("offsetx", 0),
                           layer.get("offsety", 0))
         if layer.get("type") == "tilelayer":
             _guard_json_tiles(layer, where, source, chunks)
@@ -195,7 +197,7 @@ def _guard_json(doc: dict[str, Any], folder: Path, templates: Templates) -> None
 
 
 def _guard_json_tiles(layer: dict[str, Any], where: str, source: str,
-                      chunks: ChunkTally) -> None:
+                      chunks: _ChunkTally) -> None:
     encoding = layer.get("encoding")
     if encoding == "csv":  # Tiled's default, sometimes written out: data is a list
         del layer["encoding"]
@@ -206,9 +208,9 @@ def _guard_json_tiles(layer: dict[str, Any], where: str, source: str,
 
     def check(data: Any, width: int, height: int) -> None:
         if encoding:
-            check_encoded(data, str(compression or ""), width * height, source, where)
+            _check_encoded(data, str(compression or ""), width * height, source, where)
         elif isinstance(data, list):
-            check_gids(data, width, height, source, where)
+            _check_gids(data, width, height, source, where)
         else:
             _fail(source, where, f"tile data must be a list of gids, got {type(data).__name__}")
 
@@ -273,10 +275,10 @@ def _guard_xml(root: Any, folder: Path, templates: Templates) -> None:
     for i, tileset in enumerate(root.iter("tileset")):
         if tileset.get("source"):
             files.read(folder / tileset.get("source"), f"tilesets[{i}].source")
-    chunks = ChunkTally()
+    chunks = _ChunkTally()
     for name, layer in _xml_layers(root, ""):
         where = f"layer {name!r}"
-        check_coordinates(source, where, "offset", layer.get("offsetx", 0),
+        _check_coordinates(source, where, "offset", layer.get("offsetx", 0),
                           layer.get("offsety", 0))
         if layer.tag == "layer":
             _guard_xml_tiles(layer, where, source, chunks)
@@ -285,7 +287,7 @@ def _guard_xml(root: Any, folder: Path, templates: Templates) -> None:
                 layer[i] = templates.inline_xml(obj, folder, f"{where} object {obj.get('id')}")
 
 
-def _guard_xml_tiles(layer: Any, where: str, source: str, chunks: ChunkTally) -> None:
+def _guard_xml_tiles(layer: Any, where: str, source: str, chunks: _ChunkTally) -> None:
     data = layer.find("data")
     if data is None:
         return
@@ -298,7 +300,7 @@ def _guard_xml_tiles(layer: Any, where: str, source: str, chunks: ChunkTally) ->
 
     def check(element: Any, width: int, height: int) -> None:
         if encoding == "base64":
-            check_encoded((element.text or "").strip(), compression, width * height, source,
+            _check_encoded((element.text or "").strip(), compression, width * height, source,
                           where)
             return
         tiles = element.findall("tile")
@@ -308,7 +310,7 @@ def _guard_xml_tiles(layer: Any, where: str, source: str, chunks: ChunkTally) ->
                 element.remove(tile)
         text = (element.text or "").strip()
         values = [v.strip() for v in text.split(",")] if text else []
-        check_gids([_whole(v) for v in values], width, height, source, where)
+        _check_gids([_whole(v) for v in values], width, height, source, where)
 
     found = data.findall("chunk")
     if not found:

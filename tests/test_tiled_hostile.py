@@ -13,6 +13,7 @@ import json
 import os
 import sys
 import time
+import types
 import warnings
 from pathlib import Path
 
@@ -129,7 +130,8 @@ class _Recorder:
 
     def _wrap(self, label: str, real):  # noqa: ANN001, ANN202 - any signature
         def recorded(target, *args, **kwargs):  # noqa: ANN001, ANN202
-            frame, stack = sys._getframe(1), []
+            frame: types.FrameType | None = sys._getframe(1)
+            stack: list[str] = []
             while frame is not None:
                 stack.append(frame.f_code.co_qualname)
                 if frame.f_code is navmesh.files.read_regular.__code__:
