@@ -46,7 +46,7 @@ from shapely.geometry import Polygon, box
 from navmesh.errors import LevelError, LevelWarning
 from navmesh.level_fields import zone_kinds
 from navmesh.level_format import Level, parse_level
-from navmesh.tiled_guard import MapFiles, check_map_cells
+from navmesh.tiled_guard import MAX_COORDINATE, MapFiles, check_map_cells
 from navmesh.tiled_read import read_map
 
 __all__ = ["ELLIPSE_SIDES", "load_tiled", "tiled_level_data"]
@@ -115,6 +115,8 @@ def tiled_level_data(path: Path, source: str, raw: bytes | None = None
     if tile_w != tile_h or tile_w <= 0:
         _fail(source, "map", f"tiles of {tile_w}x{tile_h} pixels are not supported; "
                              "tiles must be square")
+    if tile_w > MAX_COORDINATE:
+        _fail(source, "map", f"tiles wider than {MAX_COORDINATE} pixels are not supported")
     cell_size = _cell_size(tmap, source)
     found = _Collected()
     _collect(tmap.layers, "", 0.0, 0.0, found, source)
@@ -220,7 +222,7 @@ def _cell_size(tmap: pytiled_parser.TiledMap, source: str) -> float:
     value = (tmap.properties or {}).get("cell_size", 1.0)
     if isinstance(value, bool) or not isinstance(value, (int, float)):
         _fail(source, "map property cell_size", f"expected a number, got {value!r}")
-    if not (math.isfinite(value) and value > 0):
+    if not (math.isfinite(_float(value)) and value > 0):
         _fail(source, "map property cell_size", f"must be a finite number > 0, got {value!r}")
     return float(value)
 
@@ -316,16 +318,16 @@ def _object_geometry(
                           "ellipse object")
     if isinstance(obj, to.Polyline):
         _fail(src, where, "a polyline is not closed; use a polygon object")
-    x, y = float(obj.coordinates.x) + ox, float(obj.coordinates.y) + oy
+    x, y = _float(obj.coordinates.x) + ox, _float(obj.coordinates.y) + oy
     _finite(src, where, "position", x, y)
     if isinstance(obj, to.Point):
         if want_area:
             _fail(src, where, "a point object has no area; use a rectangle, polygon or ellipse")
         return shapely.Point(x, y)
-    w, h = float(obj.size.width), float(obj.size.height)
-    _finite(src, where, "size and rotation", w, h, float(obj.rotation))
+    w, h = _float(obj.size.width), _float(obj.size.height)
+    _finite(src, where, "size and rotation", w, h, _float(obj.rotation))
     if isinstance(obj, to.Polygon):
-        local = np.array([(float(p.x), float(p.y)) for p in obj.points]).reshape(-1, 2)
+        local = np.array([(_float(p.x), _float(p.y)) for p in obj.points]).reshape(-1, 2)
         _finite(src, where, "points", *local.ravel())
     elif isinstance(obj, to.Ellipse):
         angles = 2.0 * np.pi * np.arange(ELLIPSE_SIDES) / ELLIPSE_SIDES
@@ -340,7 +342,7 @@ def _object_geometry(
         return shapely.Point(x, y)  # a zero-size rectangle is how older Tiled wrote points
     if len(local) < 3:
         _fail(src, where, f"polygon needs at least 3 points, got {len(local)}")
-    theta = math.radians(float(obj.rotation))  # degrees clockwise on screen, about (x, y)
+    theta = math.radians(_float(obj.rotation))  # degrees clockwise on screen, about (x, y)
     cos, sin = math.cos(theta), math.sin(theta)
     if theta:
         local = local @ np.array([[cos, sin], [-sin, cos]])
@@ -467,6 +469,15 @@ def _origin(fld: str, origins: dict[str, str]) -> str:
     best = max((k for k in origins if fld == k or fld.startswith(k + "[")
                 or fld.startswith(k + ".")), key=len, default=None)
     return origins[best] if best is not None else fld
+
+
+def _float(value: Any) -> float:
+    """A number of the map as a float; an integer beyond a float's range is infinite (a JSON
+    map may hold 10^400), which :func:`_finite` then refuses."""
+    try:
+        return float(value)
+    except OverflowError:
+        return math.inf if value > 0 else -math.inf
 
 
 def _finite(src: str, where: str, what: str, *values: float) -> None:

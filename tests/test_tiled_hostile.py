@@ -307,6 +307,25 @@ def test_a_tmj_object_at_nan_and_a_polygon_point_at_nan(tmp_path, capsys):
     refused(tmx(tmp_path, objects=GUARD + polygon), "points must be finite numbers", capsys)
 
 
+@pytest.mark.parametrize("key,message", [
+    ('"x": 48', "object 3 (guard): position must be finite numbers, got inf"),
+    ('"rotation": 0', "object 3 (guard): size and rotation must be finite numbers, got inf"),
+    ('"tilewidth": 32', "map: tiles wider than 2147483648 pixels are not supported"),
+    ('"value": 7', "map property cell_size: must be a finite number > 0"),
+])
+def test_integers_beyond_a_float_are_one_line(tmp_path, capsys, key, message):
+    """JSON integers have no limit: 10^400 where a number is read ends in one line."""
+    guard = {"id": 3, "type": "guard", "x": 48, "y": 48, "width": 4, "height": 4, "rotation": 0}
+    path = tmj(tmp_path, [guard], properties=[{"name": "cell_size", "type": "int", "value": 7}])
+    text = path.read_text()
+    huge = key.split(": ")[0] + ": 1" + "0" * 400
+    if key.startswith('"tilewidth"'):
+        text = text.replace('"tileheight": 32', huge.replace("width", "height"))
+    assert key in text
+    path.write_text(text.replace(key, huge))
+    refused(path, message, capsys)
+
+
 def test_a_chunk_or_an_offset_far_out_is_one_line(tmp_path, capsys):
     tsx(tmp_path)
     far = ('<data encoding="csv"><chunk x="1000000000000000000000000000000" y="0" width="2" '
