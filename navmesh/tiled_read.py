@@ -61,8 +61,8 @@ def _read_tmx(path: Path, raw: bytes, source: str) -> TiledMap:
         path, attrib,
         infinite=bool(int(attrib.get("infinite", "0"))),
         layers=[parse_tmx_layer(e, _ENCODING, path.parent) for e in root if e.tag in _LAYER_TAGS],
-        size=(int(attrib["width"]), int(attrib["height"])),
-        tile=(int(attrib["tilewidth"]), int(attrib["tileheight"])),
+        size=(_whole(attrib, "width", source), _whole(attrib, "height", source)),
+        tile=(_whole(attrib, "tilewidth", source), _whole(attrib, "tileheight", source)),
     )
     properties = root.find("./properties")
     if properties is not None:
@@ -81,8 +81,8 @@ def _read_json(path: Path, raw: bytes, source: str) -> TiledMap:
         path, data,
         infinite=bool(data.get("infinite", False)),
         layers=[parse_json_layer(layer, _ENCODING, path.parent) for layer in layers],
-        size=(int(data["width"]), int(data["height"])),
-        tile=(int(data["tilewidth"]), int(data["tileheight"])),
+        size=(_whole(data, "width", source), _whole(data, "height", source)),
+        tile=(_whole(data, "tilewidth", source), _whole(data, "tileheight", source)),
     )
     properties = data.get("properties")
     if isinstance(properties, dict):  # Tiled < 1.2 wrote {"name": value}
@@ -109,6 +109,18 @@ def _tiled_map(path: Path, header: Any, *, infinite: bool, layers: list, size: t
         tilesets={},
         version=str(header.get("version", "")),
     )
+
+
+def _whole(header: Any, key: str, source: str) -> int:
+    """A header size in tiles or pixels: a whole number (a TMX attribute is its digits); a
+    missing key raises :class:`KeyError` like every other."""
+    value = header[key]
+    digits = value.strip().lstrip("+-") if isinstance(value, str) else ""
+    if digits.isascii() and digits.isdigit():
+        return int(value)
+    if isinstance(value, int) and not isinstance(value, bool):
+        return value
+    _refuse(source, f"{key} must be a whole number, got {value!r}")
 
 
 def _check_orientation(orientation: Any, source: str) -> None:

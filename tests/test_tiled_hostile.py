@@ -326,6 +326,12 @@ def test_integers_beyond_a_float_are_one_line(tmp_path, capsys, key, message):
     refused(path, message, capsys)
 
 
+@pytest.mark.parametrize("width", ["abc", "1.5", 1.5, True, "²"])
+def test_a_map_size_that_is_not_a_whole_number_is_one_line(tmp_path, capsys, width):
+    refused(tmj(tmp_path, width=width), f"map: width must be a whole number, got {width!r}",
+            capsys)
+
+
 def test_a_chunk_or_an_offset_far_out_is_one_line(tmp_path, capsys):
     tsx(tmp_path)
     far = ('<data encoding="csv"><chunk x="1000000000000000000000000000000" y="0" width="2" '
