@@ -94,11 +94,12 @@ def guard_map(doc: Any, folder: Path, source: str) -> None:
     Raises one :class:`LevelError` for a named file that is not a bounded regular file, a
     layer whose data is not width × height valid gids, or a size beyond the limits.
     """
-    templates = Templates(MapFiles(source))
+    files = MapFiles(source)
+    templates = Templates(files.read, source)
     if isinstance(doc, dict):
-        _guard_json(doc, folder, templates)
+        _guard_json(doc, folder, files, templates)
     else:
-        _guard_xml(doc, folder, templates)
+        _guard_xml(doc, folder, files, templates)
 
 
 def check_map_cells(width: int, height: int, source: str, what: str = "map") -> None:
@@ -170,8 +171,8 @@ def _check_encoded(data: Any, compression: str, tiles: int, source: str, where: 
 # --------------------------------------------------------------------------- JSON maps
 
 
-def _guard_json(doc: dict[str, Any], folder: Path, templates: Templates) -> None:
-    files = templates.files
+def _guard_json(doc: dict[str, Any], folder: Path, files: MapFiles, templates: Templates
+                ) -> None:
     source = files.source
     size = _size(doc)
     if size is not None and not doc.get("infinite"):
@@ -266,8 +267,7 @@ def _required_size(thing: dict[str, Any], source: str, where: str) -> tuple[int,
 # --------------------------------------------------------------------------- TMX maps
 
 
-def _guard_xml(root: Any, folder: Path, templates: Templates) -> None:
-    files = templates.files
+def _guard_xml(root: Any, folder: Path, files: MapFiles, templates: Templates) -> None:
     source = files.source
     size = _xml_size(root)
     if size is not None and root.get("infinite", "0") != "1":

@@ -10,7 +10,7 @@ Tiled, a map of either format may use templates of either format (``.tx`` or ``.
 template in the other format is converted (its attributes, shape and scalar properties;
 class-typed properties, which a level never reads, are left out).
 
-Each template and its tileset are read through :class:`navmesh.tiled_guard.MapFiles`, so a
+Each template and its tileset are read through the map's one reader (``MapFiles``), so a
 FIFO, a device or a huge file is refused like any file a map names; the tileset is only
 checked, never parsed (a level needs no tile images). Every placed object counts its
 template's size against :data:`navmesh.level_fields.MAX_FILE_BYTES`, so a small map cannot
@@ -22,14 +22,11 @@ from __future__ import annotations
 import json
 import xml.etree.ElementTree as etree
 from pathlib import Path
-from typing import TYPE_CHECKING, Any, Callable, NoReturn
+from typing import Any, Callable, NoReturn
 
 from navmesh.errors import LevelError
 from navmesh.level_fields import MAX_FILE_BYTES
 from navmesh.tiled_format import is_tiled_xml
-
-if TYPE_CHECKING:
-    from navmesh.tiled_guard import MapFiles
 
 __all__ = ["Templates"]
 
@@ -37,10 +34,15 @@ _SHAPES = ("ellipse", "point", "polygon", "polyline", "text")
 
 
 class Templates:
-    """The templates one map uses: each read and decoded once, merged into each object."""
+    """The templates one map uses: each read and decoded once, merged into each object.
 
-    def __init__(self, files: MapFiles) -> None:
-        self.files = files
+    ``read(path, field)`` is the map's one reader (:meth:`navmesh.tiled_guard.MapFiles.read`);
+    ``source`` names the map in errors.
+    """
+
+    def __init__(self, read: Callable[[Path, str], bytes], source: str) -> None:
+        self.read = read
+        self.source = source
         self._decoded: dict[Path, Any] = {}
         self._expanded = 0
 
@@ -87,7 +89,7 @@ class Templates:
         if not isinstance(named, str) or not named:
             self._fail(field, f"must name a template file, got {named!r}")
         path = folder / named
-        raw = self.files.read(path, field)
+        raw = self.read(path, field)
         self._expanded += len(raw)
         if self._expanded > MAX_FILE_BYTES:
             self._fail(field, f"the map's objects expand to more than "
@@ -133,11 +135,11 @@ class Templates:
         if named is not None:
             if not isinstance(named, str):
                 self._fail(f"{field}'s tileset", f"source must be a file name, got {named!r}")
-            self.files.read(path.parent / named, f"{field}'s tileset")
+            self.read(path.parent / named, f"{field}'s tileset")
         return template
 
     def _fail(self, field: str, problem: str) -> NoReturn:
-        raise LevelError(self.files.source, field, problem)
+        raise LevelError(self.source, field, problem)
 
 
 # --------------------------------------------------------------------------- conversion
