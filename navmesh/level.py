@@ -154,7 +154,7 @@ def _parse_content(content: _LevelFile) -> Level:
     if tiled:
         from navmesh.tiled import load_tiled  # lazy: pytiled-parser only when a map is read
 
-        return load_tiled(content.path, content.source, content.digest)
+        return load_tiled(content.path, content.source, content.digest, content.raw)
     return parse_level(data, content.source, path=content.path, digest=content.digest)
 
 

@@ -46,7 +46,7 @@ from shapely.geometry import Polygon, box
 from navmesh.errors import LevelError, LevelWarning
 from navmesh.level_fields import zone_kinds
 from navmesh.level_format import Level, parse_level
-from navmesh.tiled_guard import check_map_cells, guard_json_map
+from navmesh.tiled_guard import MAX_COORDINATE, MapFiles, check_map_cells
 from navmesh.tiled_read import read_map
 
 __all__ = ["ELLIPSE_SIDES", "load_tiled", "tiled_level_data"]
@@ -77,16 +77,18 @@ class _Collected:
     layer: an infinite map's extent when it has no walls, obstacles or outline."""
 
 
-def load_tiled(path: Path, source: str, digest: str | None = None) -> Level:
+def load_tiled(path: Path, source: str, digest: str | None = None,
+               raw: bytes | None = None) -> Level:
     """Read a Tiled map and validate it as a level; errors name the Tiled layer or object.
 
-    ``digest`` is the content identity of the file (see :func:`navmesh.level.cached_level`).
+    ``raw`` is the map's bytes if the caller has read them (else they are read here, bounded);
+    ``digest`` is their content identity (see :func:`navmesh.level.cached_level`).
     The map's :class:`~navmesh.errors.LevelWarning` lines are issued only if it loads: a
     refused map is its one error line.
     """
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always", LevelWarning)
-        data, origins = tiled_level_data(path, source)
+        data, origins = tiled_level_data(path, source, raw)
         try:
             level = parse_level(data, source, path=path, digest=digest, require_guards=False)
         except LevelError as exc:
@@ -96,13 +98,16 @@ def load_tiled(path: Path, source: str, digest: str | None = None) -> Level:
     return level
 
 
-def tiled_level_data(path: Path, source: str) -> tuple[dict[str, Any], dict[str, str]]:
+def tiled_level_data(path: Path, source: str, raw: bytes | None = None
+                     ) -> tuple[dict[str, Any], dict[str, str]]:
     """The SPEC §8 level structure of a Tiled map, and where each of its entries came from.
 
     The second value maps a field of the structure (``"guards[1]"``, ``"obstacles[0]"``,
     ``"grid"``, ...) to the Tiled layer or object it was made from.
     """
-    tmap = _read_map(path, source)
+    if raw is None:
+        raw = MapFiles(source).read(path, "map")
+    tmap = _read_map(path, raw, source)
     if tmap.orientation != "orthogonal":
         _fail(source, "map", f"orientation {tmap.orientation!r} is not supported; "
                              "only orthogonal maps are")
@@ -110,6 +115,8 @@ def tiled_level_data(path: Path, source: str) -> tuple[dict[str, Any], dict[str,
     if tile_w != tile_h or tile_w <= 0:
         _fail(source, "map", f"tiles of {tile_w}x{tile_h} pixels are not supported; "
                              "tiles must be square")
+    if tile_w > MAX_COORDINATE:
+        _fail(source, "map", f"tiles wider than {MAX_COORDINATE} pixels are not supported")
     cell_size = _cell_size(tmap, source)
     found = _Collected()
     _collect(tmap.layers, "", 0.0, 0.0, found, source)
@@ -188,24 +195,24 @@ def tiled_level_data(path: Path, source: str) -> tuple[dict[str, Any], dict[str,
 # --------------------------------------------------------------------------- reading
 
 
-def _read_map(path: Path, source: str) -> pytiled_parser.TiledMap:
+def _read_map(path: Path, raw: bytes, source: str) -> pytiled_parser.TiledMap:
     """Read with :func:`navmesh.tiled_read.read_map`; any failure becomes a one-line LevelError.
 
     The reader signals malformed input with whatever its code happens to raise (KeyError for
-    a missing key, TypeError, ValueError, NotImplementedError for TMX templates, OSError for
-    a missing tileset file, ...), so everything it raises is caught here and reported with
+    a missing key, TypeError, ValueError, RecursionError for layers nested too deep, ...),
+    so everything it raises is caught here and reported with
     its type: the map is user input and must never end in a traceback. The files it names
     and its layers' data are bounded first (:mod:`navmesh.tiled_guard`).
     """
-    guard_json_map(path, source)
     try:
-        return read_map(path, source)
+        return read_map(path, raw, source)
     except LevelError:
         raise
     except KeyError as exc:
         _fail(source, "map", f"not a Tiled map Stealthfield can read: missing key {exc}")
-    except FileNotFoundError as exc:
-        _fail(source, "map", f"a file the map refers to is missing: {exc.filename}")
+    except RecursionError:
+        _fail(source, "map", "not a Tiled map Stealthfield can read: nested too deeply "
+                             "(RecursionError)")
     except Exception as exc:  # noqa: BLE001 - third-party reader, see the docstring
         _fail(source, "map", f"not a Tiled map Stealthfield can read: "
                              f"{type(exc).__name__}: {exc}")
@@ -215,7 +222,7 @@ def _cell_size(tmap: pytiled_parser.TiledMap, source: str) -> float:
     value = (tmap.properties or {}).get("cell_size", 1.0)
     if isinstance(value, bool) or not isinstance(value, (int, float)):
         _fail(source, "map property cell_size", f"expected a number, got {value!r}")
-    if not (math.isfinite(value) and value > 0):
+    if not (math.isfinite(_float(value)) and value > 0):
         _fail(source, "map property cell_size", f"must be a finite number > 0, got {value!r}")
     return float(value)
 
@@ -311,14 +318,17 @@ def _object_geometry(
                           "ellipse object")
     if isinstance(obj, to.Polyline):
         _fail(src, where, "a polyline is not closed; use a polygon object")
-    x, y = float(obj.coordinates.x) + ox, float(obj.coordinates.y) + oy
+    x, y = _float(obj.coordinates.x) + ox, _float(obj.coordinates.y) + oy
+    _finite(src, where, "position", x, y)
     if isinstance(obj, to.Point):
         if want_area:
             _fail(src, where, "a point object has no area; use a rectangle, polygon or ellipse")
         return shapely.Point(x, y)
-    w, h = float(obj.size.width), float(obj.size.height)
+    w, h = _float(obj.size.width), _float(obj.size.height)
+    _finite(src, where, "size and rotation", w, h, _float(obj.rotation))
     if isinstance(obj, to.Polygon):
-        local = np.array([(float(p.x), float(p.y)) for p in obj.points])
+        local = np.array([(_float(p.x), _float(p.y)) for p in obj.points]).reshape(-1, 2)
+        _finite(src, where, "points", *local.ravel())
     elif isinstance(obj, to.Ellipse):
         angles = 2.0 * np.pi * np.arange(ELLIPSE_SIDES) / ELLIPSE_SIDES
         local = np.column_stack([w / 2 * (1 + np.cos(angles)), h / 2 * (1 + np.sin(angles))])
@@ -332,11 +342,13 @@ def _object_geometry(
         return shapely.Point(x, y)  # a zero-size rectangle is how older Tiled wrote points
     if len(local) < 3:
         _fail(src, where, f"polygon needs at least 3 points, got {len(local)}")
-    theta = math.radians(float(obj.rotation))  # degrees clockwise on screen, about (x, y)
+    theta = math.radians(_float(obj.rotation))  # degrees clockwise on screen, about (x, y)
     cos, sin = math.cos(theta), math.sin(theta)
     if theta:
         local = local @ np.array([[cos, sin], [-sin, cos]])
-    polygon = Polygon(local + (x, y))
+    corners = local + (x, y)
+    _finite(src, where, "corners (position + size)", *corners.ravel())
+    polygon = Polygon(corners)
     if not want_area:
         if not polygon.is_valid or polygon.area <= 0:
             _fail(src, where, "shape is not a simple polygon, so it has no centre")
@@ -457,6 +469,22 @@ def _origin(fld: str, origins: dict[str, str]) -> str:
     best = max((k for k in origins if fld == k or fld.startswith(k + "[")
                 or fld.startswith(k + ".")), key=len, default=None)
     return origins[best] if best is not None else fld
+
+
+def _float(value: Any) -> float:
+    """A number of the map as a float; an integer beyond a float's range is infinite (a JSON
+    map may hold 10^400), which :func:`_finite` then refuses."""
+    try:
+        return float(value)
+    except OverflowError:
+        return math.inf if value > 0 else -math.inf
+
+
+def _finite(src: str, where: str, what: str, *values: float) -> None:
+    """A Tiled object's numbers must be finite (a TMX ``x="nan"`` or a JSON ``NaN``)."""
+    bad = next((v for v in values if not math.isfinite(v)), None)
+    if bad is not None:
+        _fail(src, where, f"{what} must be finite numbers, got {bad:g}")
 
 
 def _fail(src: str, fld: str, problem: str) -> NoReturn:

@@ -1,54 +1,105 @@
-"""Bounds on a Tiled JSON map, checked before pytiled-parser reads it (SPEC §8, §10).
+"""Bounds on a Tiled map, checked on the decoded map before pytiled-parser reads it (SPEC §10).
 
-pytiled-parser opens every file a map names (external tilesets, object templates and their
-tilesets) with a plain :func:`open` and inflates every compressed layer whole, so a FIFO
-named as a tileset blocks for ever, ``/dev/zero`` is read until memory runs out and a
-12 KB zstd layer can inflate to 400 MB. :func:`guard_json_map` walks the map first with the
-same rules as every other input: each named file through :func:`navmesh.files.read_regular`,
-each layer's data through :func:`navmesh.files.inflate_bounded` against the size its tiles
-take (width × height × 4 bytes), and the map's own size against the cell limit — so a map
-that passes is one pytiled-parser reads in bounded time and memory.
+pytiled-parser opens every file a map names (object templates and their tilesets) with a
+plain :func:`open`, inflates every compressed layer whole and takes tile data of any length,
+so a FIFO named as a template's tileset blocks for ever, ``/dev/zero`` is read until memory
+runs out, a 12 KB zstd layer can inflate to 400 MB and a layer of 380 values for 400 tiles
+loads silently. :func:`guard_map` walks the decoded map (JSON or TMX) first, with the same
+rules as every other input:
+
+* each file the map names — external tilesets, object templates, a template's tileset — is
+  read by one :class:`MapFiles`, through :func:`navmesh.files.read_regular` (a regular file
+  of at most 64 MiB; all of them together at most 64 MiB and :data:`MAX_NAMED_FILES`
+  files); templates are merged into their objects (:mod:`navmesh.tiled_templates`), so
+  pytiled-parser opens nothing;
+* each layer's or chunk's data holds exactly width × height gids, each in [0, 2^32): base64
+  is inflated by :func:`navmesh.files.inflate_bounded` against width × height × 4 bytes;
+  TMX's old ``<tile gid="…"/>`` form is rewritten as the CSV it means;
+* sizes meet the cell limit and chunk coordinates and layer offsets lie within ±2^31; a
+  layer or chunk of no tiles is dropped (pytiled-parser would divide by its zero width), and
+  a JSON object gets the keys every Tiled writes (``name``, ``visible``, ...) if it lacks them.
+
+A map that passes is one pytiled-parser reads in bounded time and memory.
 """
 
 from __future__ import annotations
 
 import base64
 import binascii
-import json
+import math
+import os
 from pathlib import Path
 from typing import Any, NoReturn
 
-from navmesh.files import FileRefused, inflate_bounded, read_regular
 from navmesh.errors import LevelError
+from navmesh.files import FileRefused, inflate_bounded, read_regular
 from navmesh.level_fields import MAX_CELLS, MAX_FILE_BYTES
+from navmesh.tiled_templates import Templates
 
-__all__ = ["MAX_CHUNK_CELLS", "check_map_cells", "guard_json_map"]
+__all__ = ["MAX_CHUNK_CELLS", "MAX_COORDINATE", "MAX_NAMED_FILES", "MapFiles",
+           "check_map_cells", "guard_map"]
 
 MAX_CHUNK_CELLS = 4 * MAX_CELLS
 """Tiles an infinite map's chunks may hold together (its content must still fit in
 :data:`navmesh.level.MAX_CELLS` cells; empty chunks around it are allowed)."""
 
+MAX_NAMED_FILES = 1000
+"""Distinct files (tilesets, templates) one map may name."""
 
-def guard_json_map(path: Path, source: str) -> None:
-    """Refuse, with one :class:`LevelError`, a map naming a file that is not a bounded regular
-    file, a layer whose data inflates past its tiles, or a map beyond the cell limit."""
-    raw = _named_file(path, source, "map")
-    if raw.lstrip()[:1] == b"<":
-        _guard_xml_map(raw, path.parent, source)
-        return
-    doc = _json_bytes(raw)
-    if not isinstance(doc, dict):
-        return  # pytiled-parser's own error names what is wrong
-    if not doc.get("infinite"):
-        size = _size(doc)
-        if size is not None:
-            check_map_cells(*size, source)
-    for i, tileset in enumerate(_list(doc.get("tilesets"))):
-        if isinstance(tileset, dict) and isinstance(tileset.get("source"), str):
-            _named_file(path.parent / tileset["source"], source, f"tilesets[{i}].source")
-    chunk_cells = [0]
-    for name, layer in _layers(_list(doc.get("layers")), ""):
-        _guard_layer(layer, name, path.parent, source, chunk_cells)
+MAX_COORDINATE = 2**31
+"""Bound of a chunk's tile coordinates and a layer's pixel offsets (Tiled's are 32-bit)."""
+
+_OBJECT_DEFAULTS = {"name": "", "visible": True, "rotation": 0, "width": 0, "height": 0}
+_GID_END = 2**32  # a gid is an unsigned 32-bit number (flip flags in its top bits)
+
+
+class MapFiles:
+    """The one reader of the files a map names: each read once, through
+    :func:`navmesh.files.read_regular`, and all of them bounded together."""
+
+    def __init__(self, source: str) -> None:
+        self.source = source
+        self._read: dict[str, bytes] = {}
+        self._total = 0
+
+    def read(self, path: Path, where: str) -> bytes:
+        """The bytes of ``path``, a file the map names at ``where``; any problem is one
+        :class:`LevelError` naming the file."""
+        key = os.path.normpath(path)  # a string operation: no file is touched
+        if key in self._read:
+            return self._read[key]
+        if len(self._read) >= MAX_NAMED_FILES:
+            _fail(self.source, where, f"the map names more than {MAX_NAMED_FILES} files")
+        try:
+            raw = read_regular(path, MAX_FILE_BYTES)
+        except FileRefused as refused:
+            _fail(self.source, where, f"{path} {refused}")
+        except FileNotFoundError:
+            _fail(self.source, where, f"a file the map refers to is missing: {path}")
+        except OSError as exc:
+            _fail(self.source, where, f"cannot read {path} ({exc.strerror or exc})")
+        except ValueError as exc:  # a NUL byte in the name
+            _fail(self.source, where, f"cannot read {str(path)!r} ({exc})")
+        self._total += len(raw)
+        if self._total > MAX_FILE_BYTES:
+            _fail(self.source, where, f"the files the map names hold more than "
+                                      f"{MAX_FILE_BYTES // 2**20} MiB together")
+        self._read[key] = raw
+        return raw
+
+
+def guard_map(doc: Any, folder: Path, source: str) -> None:
+    """Check (and normalise in place) a decoded map: a JSON ``dict`` or a TMX root element.
+
+    Raises one :class:`LevelError` for a named file that is not a bounded regular file, a
+    layer whose data is not width × height valid gids, or a size beyond the limits.
+    """
+    files = MapFiles(source)
+    templates = Templates(files.read, source)
+    if isinstance(doc, dict):
+        _guard_json(doc, folder, files, templates)
+    else:
+        _guard_xml(doc, folder, files, templates)
 
 
 def check_map_cells(width: int, height: int, source: str, what: str = "map") -> None:
@@ -60,41 +111,47 @@ def check_map_cells(width: int, height: int, source: str, what: str = "map") -> 
                             f"limit of {MAX_CELLS} cells")
 
 
-def _guard_layer(layer: dict[str, Any], name: str, folder: Path, source: str,
-                 chunk_cells: list[int]) -> None:
-    where = f"layer {name!r}"
-    if layer.get("type") == "tilelayer":
-        compression = layer.get("compression") or ""
-        encoded = layer.get("encoding") == "base64"
-        if "data" in layer:
-            size = _size(layer)
-            if size is not None:
-                check_map_cells(*size, source, where)
-                _guard_data(layer["data"], encoded, compression, size[0] * size[1], where,
-                            source)
-        for chunk in _list(layer.get("chunks")):
-            if not isinstance(chunk, dict):
-                continue
-            size = _size(chunk)
-            if size is not None:
-                check_map_cells(*size, source, where)
-                width, height = size
-                chunk_cells[0] += width * height
-                if chunk_cells[0] > MAX_CHUNK_CELLS:
-                    _fail(source, where, f"chunks of more than {MAX_CHUNK_CELLS} tiles "
-                                         "in all")
-                _guard_data(chunk.get("data"), encoded, compression, width * height,
-                            where, source)
-    for obj in _list(layer.get("objects")):
-        if isinstance(obj, dict) and isinstance(obj.get("template"), str):
-            _template(folder / obj["template"], source, f"{where} object {obj.get('id')}")
+class _ChunkTally:
+    """The tiles of an infinite map's chunks, counted against :data:`MAX_CHUNK_CELLS`."""
+
+    def __init__(self) -> None:
+        self.cells = 0
+
+    def add(self, width: int, height: int, x: Any, y: Any, source: str, where: str) -> None:
+        check_map_cells(width, height, source, where)
+        _check_coordinates(source, where, "chunk position", x, y, integer=True)
+        self.cells += width * height
+        if self.cells > MAX_CHUNK_CELLS:
+            _fail(source, where, f"chunks of more than {MAX_CHUNK_CELLS} tiles in all")
 
 
-def _guard_data(data: Any, encoded: bool, compression: str, tiles: int, where: str,
-                source: str) -> None:
+def _check_coordinates(source: str, where: str, what: str, *values: Any,
+                      integer: bool = False) -> None:
+    """Finite numbers within ±:data:`MAX_COORDINATE` (whole ones if ``integer``)."""
+    for value in values:
+        number = _number(value)
+        if (number is None or not math.isfinite(number) or abs(number) > MAX_COORDINATE
+                or (integer and number != int(number))):
+            kind = "whole numbers" if integer else "finite numbers"
+            _fail(source, where, f"{what} must be {kind} within ±{MAX_COORDINATE}, got "
+                                 f"{value!r}")
+
+
+def _check_gids(gids: list[Any], width: int, height: int, source: str, where: str) -> None:
+    """``gids`` (CSV or a JSON list) must be exactly width × height integers in [0, 2^32)."""
+    if len(gids) != width * height:
+        _fail(source, where, f"tile data holds {len(gids)} gids, expected {width * height} "
+                             f"(one per tile of {width}x{height})")
+    for i, gid in enumerate(gids):
+        if isinstance(gid, bool) or not isinstance(gid, int) or not 0 <= gid < _GID_END:
+            _fail(source, where, f"the gid of the tile at row {i // width}, column "
+                                 f"{i % width} is {gid!r}, not a whole number in [0, 2^32)")
+
+
+def _check_encoded(data: Any, compression: str, tiles: int, source: str, where: str) -> None:
     """Base64 tile data (optionally compressed) must hold exactly ``tiles`` 4-byte gids."""
-    if not encoded or not isinstance(data, str):
-        return  # a JSON list, bounded by the file's size
+    if not isinstance(data, str):
+        _fail(source, where, f"base64 tile data must be a string, got {type(data).__name__}")
     expected = 4 * tiles
     try:
         raw = base64.b64decode(data, validate=False)
@@ -111,106 +168,80 @@ def _guard_data(data: Any, encoded: bool, compression: str, tiles: int, where: s
                              f"(4 per tile for {tiles} tiles)")
 
 
-def _template(path: Path, source: str, where: str) -> None:
-    """An object template (``.tj``) and the tileset it names, if any."""
-    doc = _json(path, source, f"{where} template")
-    if isinstance(doc, dict) and isinstance(doc.get("tileset"), dict):
-        named = doc["tileset"].get("source")
-        if isinstance(named, str):
-            _named_file(path.parent / named, source, f"{where} template's tileset")
+# --------------------------------------------------------------------------- JSON maps
 
 
-def _named_file(path: Path, source: str, where: str) -> bytes:
-    try:
-        return read_regular(path, MAX_FILE_BYTES)
-    except FileRefused as refused:
-        _fail(source, where, f"{path} {refused}")
-    except FileNotFoundError:
-        _fail(source, "map", f"a file the map refers to is missing: {path}")
-    except OSError as exc:
-        _fail(source, where, f"cannot read {path} ({exc.strerror or exc})")
-
-
-def _guard_xml_map(raw: bytes, folder: Path, source: str) -> None:
-    """The same bounds for a TMX map: its size, every file it names (tilesets, templates,
-    images are not read) and every layer's or chunk's encoded data."""
-    import xml.etree.ElementTree as ET
-
-    try:
-        root = ET.fromstring(raw)
-    except ET.ParseError:
-        return  # the reader reports the broken XML in one line
-    size = _xml_size(root)
-    if size is not None and root.get("infinite", "0") != "1":
+def _guard_json(doc: dict[str, Any], folder: Path, files: MapFiles, templates: Templates
+                ) -> None:
+    source = files.source
+    size = _size(doc)
+    if size is not None and not doc.get("infinite"):
         check_map_cells(*size, source)
-    for i, tileset in enumerate(root.iter("tileset")):
-        named = tileset.get("source")
-        if named:
-            _named_file(folder / named, source, f"tilesets[{i}].source")
-    for obj in root.iter("object"):
-        named = obj.get("template")
-        if named:
-            _named_file(folder / named, source, f"object {obj.get('id')} template")
-    chunk_cells = 0
-    for layer in root.iter("layer"):
-        where = f"layer {layer.get('name', '')!r}"
-        data = layer.find("data")
-        if data is None:
-            continue
-        encoded = data.get("encoding") == "base64"
-        compression = data.get("compression") or ""
-        chunks = data.findall("chunk")
-        if not chunks and size is not None:
-            _guard_data((data.text or "").strip(), encoded, compression,
-                        _layer_tiles(layer, size, source, where), where, source)
-        for chunk in chunks:
-            csize = _xml_size(chunk)
-            if csize is None:
+    for i, tileset in enumerate(_list(doc.get("tilesets"))):
+        if isinstance(tileset, dict) and isinstance(tileset.get("source"), str):
+            files.read(folder / tileset["source"], f"tilesets[{i}].source")
+    chunks = _ChunkTally()
+    for name, layer in _json_layers(_list(doc.get("layers")), ""):
+        where = f"layer {name!r}"
+        _check_coordinates(source, where, "offset", layer.get("offsetx", 0),
+                          layer.get("offsety", 0))
+        if layer.get("type") == "tilelayer":
+            _guard_json_tiles(layer, where, source, chunks)
+        objects = _list(layer.get("objects"))
+        for i, obj in enumerate(objects):
+            if isinstance(obj, dict) and "template" in obj:
+                objects[i] = obj = templates.inline_json(obj, folder,
+                                                         f"{where} object {obj.get('id')}")
+            if isinstance(obj, dict):  # keys every Tiled writes, which older ones left out
+                for key, value in _OBJECT_DEFAULTS.items():
+                    obj.setdefault(key, value)
+
+
+def _guard_json_tiles(layer: dict[str, Any], where: str, source: str,
+                      chunks: _ChunkTally) -> None:
+    encoding = layer.get("encoding")
+    if encoding == "csv":  # Tiled's default, sometimes written out: data is a list
+        del layer["encoding"]
+        encoding = None
+    elif encoding not in (None, "base64"):
+        _fail(source, where, f"unknown encoding {encoding!r} (csv or base64)")
+    compression = layer.setdefault("compression", "") if encoding else ""
+
+    def check(data: Any, width: int, height: int) -> None:
+        if encoding:
+            _check_encoded(data, str(compression or ""), width * height, source, where)
+        elif isinstance(data, list):
+            _check_gids(data, width, height, source, where)
+        else:
+            _fail(source, where, f"tile data must be a list of gids, got {type(data).__name__}")
+
+    if layer.get("data") is not None:
+        size = _required_size(layer, source, where)
+        check_map_cells(*size, source, where)
+        check(layer["data"], *size)
+        if 0 in size:  # no tiles: pytiled-parser would divide by the width
+            del layer["data"]
+    kept = []
+    for chunk in _list(layer.get("chunks")):
+        if isinstance(chunk, dict):
+            size = _required_size(chunk, source, f"{where} chunk")
+            chunks.add(*size, chunk.get("x"), chunk.get("y"), source, where)
+            check(chunk.get("data"), *size)
+            if 0 in size:
                 continue
-            check_map_cells(*csize, source, where)
-            chunk_cells += csize[0] * csize[1]
-            if chunk_cells > MAX_CHUNK_CELLS:
-                _fail(source, where, f"chunks of more than {MAX_CHUNK_CELLS} tiles in all")
-            _guard_data((chunk.text or "").strip(), encoded, compression,
-                        csize[0] * csize[1], where, source)
+        kept.append(chunk)
+    if "chunks" in layer and isinstance(layer["chunks"], list):
+        layer["chunks"] = kept
 
 
-def _layer_tiles(layer: Any, size: tuple[int, int], source: str, where: str) -> int:
-    own = _xml_size(layer) or size
-    check_map_cells(*own, source, where)
-    return own[0] * own[1]
-
-
-def _xml_size(element: Any) -> tuple[int, int] | None:
-    try:
-        return int(element.get("width")), int(element.get("height"))
-    except (TypeError, ValueError):
-        return None
-
-
-def _json_bytes(raw: bytes) -> Any:
-    try:
-        return json.loads(raw)
-    except (ValueError, RecursionError):
-        return None
-
-
-def _json(path: Path, source: str, where: str) -> Any:
-    raw = _named_file(path, source, where)
-    try:
-        return json.loads(raw)
-    except (ValueError, RecursionError):
-        return None  # XML (TSX/TX) or broken: pytiled-parser reports it, the file is bounded
-
-
-def _layers(layers: list[Any], parent: str) -> Any:
+def _json_layers(layers: list[Any], parent: str) -> Any:
     for layer in layers:
         if not isinstance(layer, dict):
             continue
         name = f"{parent}{layer.get('name', '')}"
         yield name, layer
         if layer.get("type") == "group":
-            yield from _layers(_list(layer.get("layers")), f"{name}/")
+            yield from _json_layers(_list(layer.get("layers")), f"{name}/")
 
 
 def _list(value: Any) -> list[Any]:
@@ -223,6 +254,124 @@ def _size(thing: dict[str, Any]) -> tuple[int, int] | None:
     if any(isinstance(v, bool) or not isinstance(v, int) for v in (width, height)):
         return None
     return int(width), int(height)  # type: ignore[arg-type]
+
+
+def _required_size(thing: dict[str, Any], source: str, where: str) -> tuple[int, int]:
+    size = _size(thing)
+    if size is None:
+        _fail(source, where, f"width and height must be whole numbers, got "
+                             f"{thing.get('width')!r} and {thing.get('height')!r}")
+    return size
+
+
+# --------------------------------------------------------------------------- TMX maps
+
+
+def _guard_xml(root: Any, folder: Path, files: MapFiles, templates: Templates) -> None:
+    source = files.source
+    size = _xml_size(root)
+    if size is not None and root.get("infinite", "0") != "1":
+        check_map_cells(*size, source)
+    for i, tileset in enumerate(root.iter("tileset")):
+        if tileset.get("source"):
+            files.read(folder / tileset.get("source"), f"tilesets[{i}].source")
+    chunks = _ChunkTally()
+    for name, layer in _xml_layers(root, ""):
+        where = f"layer {name!r}"
+        _check_coordinates(source, where, "offset", layer.get("offsetx", 0),
+                          layer.get("offsety", 0))
+        if layer.tag == "layer":
+            _guard_xml_tiles(layer, where, source, chunks)
+        for i, obj in enumerate(list(layer)):
+            if obj.tag == "object" and obj.get("template") is not None:
+                layer[i] = templates.inline_xml(obj, folder, f"{where} object {obj.get('id')}")
+
+
+def _guard_xml_tiles(layer: Any, where: str, source: str, chunks: _ChunkTally) -> None:
+    data = layer.find("data")
+    if data is None:
+        return
+    encoding = data.get("encoding") or "csv"
+    if encoding not in ("csv", "base64"):
+        _fail(source, where, f"unknown encoding {encoding!r} (csv, base64 or none)")
+    compression = data.get("compression") or ""
+    if encoding == "csv" and compression:
+        _fail(source, where, f"compression {compression!r} needs base64 encoding")
+
+    def check(element: Any, width: int, height: int) -> None:
+        if encoding == "base64":
+            _check_encoded((element.text or "").strip(), compression, width * height, source,
+                          where)
+            return
+        tiles = element.findall("tile")
+        if tiles:  # the old XML form: one <tile gid="..."/> per tile, read as its CSV
+            element.text = ",".join(tile.get("gid", "0") for tile in tiles)
+            for tile in tiles:
+                element.remove(tile)
+        text = (element.text or "").strip()
+        values = [v.strip() for v in text.split(",")] if text else []
+        _check_gids([_whole(v) for v in values], width, height, source, where)
+
+    found = data.findall("chunk")
+    if not found:
+        size = _xml_required(layer, source, where)
+        check_map_cells(*size, source, where)
+        check(data, *size)
+        if 0 in size:  # no tiles: pytiled-parser would divide by the width
+            layer.remove(data)
+    for chunk in found:
+        size = _xml_required(chunk, source, f"{where} chunk")
+        chunks.add(*size, chunk.get("x"), chunk.get("y"), source, where)
+        check(chunk, *size)
+        if 0 in size:
+            data.remove(chunk)
+    if found and data.find("chunk") is None:
+        layer.remove(data)
+
+
+def _xml_layers(parent: Any, prefix: str) -> Any:
+    for layer in parent:
+        if layer.tag not in ("layer", "objectgroup", "imagelayer", "group"):
+            continue
+        name = f"{prefix}{layer.get('name', '')}"
+        yield name, layer
+        if layer.tag == "group":
+            yield from _xml_layers(layer, f"{name}/")
+
+
+def _xml_size(element: Any) -> tuple[int, int] | None:
+    try:
+        return int(element.get("width")), int(element.get("height"))
+    except (TypeError, ValueError):
+        return None
+
+
+def _xml_required(element: Any, source: str, where: str) -> tuple[int, int]:
+    size = _xml_size(element)
+    if size is None:
+        _fail(source, where, f"width and height must be whole numbers, got "
+                             f"{element.get('width')!r} and {element.get('height')!r}")
+    return size
+
+
+def _whole(text: str) -> Any:
+    try:
+        return int(text)
+    except ValueError:
+        return text
+
+
+def _number(value: Any) -> float | None:
+    if isinstance(value, bool):
+        return None
+    if isinstance(value, (int, float)):
+        return float(value) if not isinstance(value, int) or abs(value) < 2**63 else math.inf
+    if isinstance(value, str):
+        try:
+            return float(value)
+        except ValueError:
+            return None
+    return None
 
 
 def _fail(source: str, where: str, problem: str) -> NoReturn:

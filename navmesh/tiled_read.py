@@ -1,13 +1,16 @@
 """Read a Tiled map's header, layers and properties — TMX (XML) or JSON — without its tilesets.
 
-A level needs only which gids are non-zero, so tilesets (embedded, ``.tsx``, ``.tsj``) and
-their images are never opened: a map whose tileset is missing, or was written by an older
-Tiled without ``tilecount`` or ``columns``, still loads. The header keys newer Tiled added
+A level needs only which gids are non-zero, so tilesets (embedded, ``.tsx``, ``.tsj``) are
+never parsed and their images never opened: an external tileset is only checked to be a
+bounded regular file (:mod:`navmesh.tiled_guard`), and a map written by an older Tiled
+without ``tilecount`` or ``columns`` still loads. The header keys newer Tiled added
 (``infinite``, ``nextlayerid``, ``renderorder``, ``tiledversion``, ...) default as Tiled
-does. The layers are parsed by pytiled-parser's own layer readers (every data encoding and
-compression, chunks, groups, object templates). A map that is not orthogonal is refused
-before its layers are read, so an isometric, staggered or hexagonal map gets that one line
-whatever else it holds.
+does. The map's bytes come from the caller (read once, bounded); the decoded document is
+checked and its object templates merged in by :func:`navmesh.tiled_guard.guard_map`, then
+its layers are parsed by pytiled-parser's own layer readers (every data encoding and
+compression, chunks, groups), which then open no file. A map that is not orthogonal is
+refused before anything else is checked, so an isometric, staggered or hexagonal map gets
+that one line whatever else it holds.
 """
 
 from __future__ import annotations
@@ -26,6 +29,7 @@ from pytiled_parser.parsers.tmx.properties import parse as parse_tmx_properties
 
 from navmesh.errors import LevelError
 from navmesh.tiled_format import is_tiled_xml
+from navmesh.tiled_guard import guard_map
 
 __all__ = ["ORTHOGONAL", "read_map"]
 
@@ -36,11 +40,11 @@ _ENCODING = "utf-8"
 _LAYER_TAGS = ("layer", "objectgroup", "imagelayer", "group")
 
 
-def read_map(path: Path, source: str) -> TiledMap:
-    """The map at ``path`` with ``tilesets`` empty; a map that is not orthogonal raises
+def read_map(path: Path, raw: bytes, source: str) -> TiledMap:
+    """The map at ``path``, whose bytes are ``raw``, with ``tilesets`` empty; a map that is
+    not orthogonal or fails :func:`~navmesh.tiled_guard.guard_map` raises
     :class:`LevelError` (``source`` names it). Malformed input raises whatever the XML,
     JSON or layer readers raise (the caller turns it into one line)."""
-    raw = path.read_bytes()
     if is_tiled_xml(raw):
         return _read_tmx(path, raw, source)
     return _read_json(path, raw, source)
@@ -52,12 +56,13 @@ def _read_tmx(path: Path, raw: bytes, source: str) -> TiledMap:
         raise ValueError(f"the XML's root element is <{root.tag}>, not <map>")
     attrib = root.attrib
     _check_orientation(attrib.get("orientation", ORTHOGONAL), source)
+    guard_map(root, path.parent, source)
     tmap = _tiled_map(
         path, attrib,
         infinite=bool(int(attrib.get("infinite", "0"))),
         layers=[parse_tmx_layer(e, _ENCODING, path.parent) for e in root if e.tag in _LAYER_TAGS],
-        size=(int(attrib["width"]), int(attrib["height"])),
-        tile=(int(attrib["tilewidth"]), int(attrib["tileheight"])),
+        size=(_whole(attrib, "width", source), _whole(attrib, "height", source)),
+        tile=(_whole(attrib, "tilewidth", source), _whole(attrib, "tileheight", source)),
     )
     properties = root.find("./properties")
     if properties is not None:
@@ -70,13 +75,14 @@ def _read_json(path: Path, raw: bytes, source: str) -> TiledMap:
     if not isinstance(data, dict):
         raise ValueError("the JSON is not an object")
     _check_orientation(data.get("orientation", ORTHOGONAL), source)
+    guard_map(data, path.parent, source)
     layers = data.get("layers") or []
     tmap = _tiled_map(
         path, data,
         infinite=bool(data.get("infinite", False)),
         layers=[parse_json_layer(layer, _ENCODING, path.parent) for layer in layers],
-        size=(int(data["width"]), int(data["height"])),
-        tile=(int(data["tilewidth"]), int(data["tileheight"])),
+        size=(_whole(data, "width", source), _whole(data, "height", source)),
+        tile=(_whole(data, "tilewidth", source), _whole(data, "tileheight", source)),
     )
     properties = data.get("properties")
     if isinstance(properties, dict):  # Tiled < 1.2 wrote {"name": value}
@@ -103,6 +109,18 @@ def _tiled_map(path: Path, header: Any, *, infinite: bool, layers: list, size: t
         tilesets={},
         version=str(header.get("version", "")),
     )
+
+
+def _whole(header: Any, key: str, source: str) -> int:
+    """A header size in tiles or pixels: a whole number (a TMX attribute is its digits); a
+    missing key raises :class:`KeyError` like every other."""
+    value = header[key]
+    digits = value.strip().lstrip("+-") if isinstance(value, str) else ""
+    if digits.isascii() and digits.isdigit():
+        return int(value)
+    if isinstance(value, int) and not isinstance(value, bool):
+        return value
+    _refuse(source, f"{key} must be a whole number, got {value!r}")
 
 
 def _check_orientation(orientation: Any, source: str) -> None:

@@ -400,10 +400,10 @@ def _bad_maps(w: MapWriter) -> list[tuple[str, dict, str]]:
                          if k != "tilewidth"}, "map: not a Tiled map .*missing key 'tilewidth'"),
         ("missing template", w.map(20, 20, objs(guard(), {"id": 98, "template": "nowhere.tj",
                                                          "x": 48, "y": 48})),
-         "map: a file the map refers to is missing: .*nowhere.tj"),
+         "layer 'things' object 98 template: a file the map refers to is missing: .*nowhere.tj"),
         ("tmx template", w.map(20, 20, objs(guard(), {"id": 99, "template": "guard.tx",
                                                      "x": 48, "y": 48})),
-         "map: not a Tiled map .*NotImplementedError"),
+         r"object 99 template: .*guard.tx is not an object template \(no <template> holding"),
         ("infinite, empty", w.map(20, 20, [w.objects("o", [guard()])], infinite=True),
          "map: an infinite map without tiles, obstacles or an outline object has no extent"),
     ]
