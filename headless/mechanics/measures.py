@@ -32,7 +32,7 @@ from typing import Any
 
 import numpy as np
 
-from ai.stimuli import footstep_rule
+from ai.stimuli import Corpse, footstep_rule
 from ai.view import Action, Event
 from game.world import World
 
@@ -107,7 +107,7 @@ def corpse(level: str, abstraction: str, seed: int) -> Measures:
             if w.step_index % w.steps_per_tick:
                 return
             track.append(float(np.min(w.graph.hops_between(active_guard_nodes(w), body))))
-            present = any(s.name == "corpse" for s in w.stimuli.active)
+            present = any(isinstance(s, Corpse) for s in w.stimuli.active)
             if on and present:
                 found[0] = True
             elif on and found[0] and not present and removal is None:
