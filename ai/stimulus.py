@@ -2,7 +2,9 @@
 
 A :class:`Stimulus` knows how it injects into the information field, how it decays and when
 it ends; it sees the trial through a :class:`FieldContext` and declares how
-``stealth mechanics --stimulus`` measures it (:class:`Measure`). The built-in mechanics are in
+``stealth mechanics --stimulus`` measures it (:class:`Measure`). Its class declares its
+names and its own config parameters, and :data:`STIMULUS_TYPES` holds the classes known by
+name (the built-ins, the plugins loaded). The built-in mechanics are in
 :mod:`ai.builtin_stimuli`, the set that drives them in :mod:`ai.stimuli`.
 """
 
