@@ -10,7 +10,7 @@ from typing import Any
 
 import numpy as np
 
-from .stimulus import FieldContext, Rule, Sound, Stimulus
+from .stimulus import FieldContext, Rule, Sound, Stimulus, register_stimulus
 from .view import Event, WorldView
 
 
@@ -78,6 +78,34 @@ class Noise(Stimulus):
         return {"name": self.name, "node": self.node, "level": round(self.level, 6)}
 
 
+@register_stimulus
+class Footstep(Noise):
+    """A footstep while sprinting: a :class:`Noise` the game does not draw."""
+
+    name = "footstep"
+    display = "footstep noise"
+    short = "footstep"
+
+    def __init__(self, node: int, amplitude: float = 3.0, falloff: float = 0.6,
+                 **kwargs: Any) -> None:
+        super().__init__(node, amplitude, falloff, name=self.name, marker=False, **kwargs)
+
+
+@register_stimulus
+class ThrownNoise(Noise):
+    """A thrown decoy's landing: a :class:`Noise` like a footstep, drawn where it landed."""
+
+    name = "thrown_decoy"
+    display = "thrown decoy"
+    short = "throw"
+    marker = True
+
+    def __init__(self, node: int, amplitude: float = 3.0, falloff: float = 0.6,
+                 **kwargs: Any) -> None:
+        super().__init__(node, amplitude, falloff, name=self.name, marker=True, **kwargs)
+
+
+@register_stimulus
 class StaticDecoy(Stimulus):
     """An activated level decoy: ``−A·β^d`` over the whole map, constant.
 
@@ -86,6 +114,8 @@ class StaticDecoy(Stimulus):
     """
 
     name = "decoy"
+    display = "static decoy"
+    short = "decoy"
     marker = True
 
     def __init__(
@@ -114,6 +144,7 @@ class StaticDecoy(Stimulus):
         return {"name": self.name, "node": self.node, "stood": round(self.presence.seconds, 6)}
 
 
+@register_stimulus
 class Corpse(Stimulus):
     """A guard's body: ``−A·γ^t·δ^d`` with t the seconds since the take-down.
 
@@ -164,6 +195,7 @@ class Corpse(Stimulus):
                 "inspected": round(self.presence.seconds, 6)}
 
 
+@register_stimulus
 class Rain(Stimulus):
     """Weather: while it rains every new noise is quieter and dies out sooner.
 
@@ -188,23 +220,22 @@ class Rain(Stimulus):
 # ---------------------------------------------------------------------------- event rules
 
 
-def _noise(event: Event, ctx: FieldContext, name: str, marker: bool) -> Noise:
+def _noise(event: Event, ctx: FieldContext, kind: type[Footstep | ThrownNoise]) -> Noise:
     p = ctx.params
     sound = ctx.sound()
     age = max(0.0, ctx.t - event.t)
-    return Noise(event.node, sound.amplitude * p.noise_decay**age, sound.falloff,
-                 max_hops=p.noise_max_hops, decay=p.noise_decay, threshold=p.noise_threshold,
-                 name=name, marker=marker)
+    return kind(event.node, sound.amplitude * p.noise_decay**age, sound.falloff,
+                max_hops=p.noise_max_hops, decay=p.noise_decay, threshold=p.noise_threshold)
 
 
 def footstep_rule(event: Event, ctx: FieldContext) -> Noise:
     """``"sprint"`` → a footstep noise at the player's node (one per AI tick of sprinting)."""
-    return _noise(event, ctx, "footstep", False)
+    return _noise(event, ctx, Footstep)
 
 
 def throw_rule(event: Event, ctx: FieldContext) -> Noise:
     """``"throw_landed"`` → one noise impulse at the landing node, like a footstep."""
-    return _noise(event, ctx, "thrown_decoy", True)
+    return _noise(event, ctx, ThrownNoise)
 
 
 def decoy_rule(event: Event, ctx: FieldContext) -> StaticDecoy:

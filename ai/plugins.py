@@ -12,7 +12,7 @@ from typing import Any
 from navmesh.level import register_zone_kind
 
 from .errors import StimulusError
-from .stimulus import Measure, Stimulus
+from .stimulus import Measure, Stimulus, register_stimulus
 
 #: importlib.metadata entry-point group under which installed packages register stimuli
 ENTRY_POINT_GROUP = "stealthfield.stimuli"
@@ -68,8 +68,10 @@ def load_stimulus(spec: str) -> StimulusFactory:
     ``Name`` must be a :class:`Stimulus` subclass that can be created with no arguments, or
     a function of no arguments returning a :class:`Stimulus`; installed packages register
     either under the ``stealthfield.stimuli`` entry-point group. The factory is called once
-    here to check it, and the zone kinds it declares (:attr:`Stimulus.zone_kinds`) are
-    registered, so load plugins **before** the levels that use their zones. Raises
+    here to check it, the zone kinds it declares (:attr:`Stimulus.zone_kinds`) are
+    registered, so load plugins **before** the levels that use their zones, and its class
+    is registered (:func:`~ai.stimulus.register_stimulus`), so load them before the config
+    that sets their :attr:`~Stimulus.parameters`. Raises
     :class:`StimulusError` (one line) otherwise.
     """
     text = str(spec).strip()
@@ -105,6 +107,10 @@ def load_stimulus(spec: str) -> StimulusFactory:
     if not isinstance(probe.measure, Measure):
         raise StimulusError(f"{text}: measure must be an ai.stimuli.Measure, "
                             f"got {type(probe.measure).__name__}")
+    try:
+        register_stimulus(type(probe))  # its names, and its parameters' config section
+    except StimulusError as error:
+        raise StimulusError(f"{text}: {error}") from None
     return obj
 
 

@@ -45,12 +45,15 @@ from navmesh.graph import NodeGraph
 
 from . import plugin_call
 from .builtin_stimuli import (
-    DEFAULT_RULES, Corpse, GuardPresence, Noise, Rain, StaticDecoy, corpse_rule, decoy_rule,
-    footstep_rule, throw_rule, weather_rule,
+    DEFAULT_RULES, Corpse, Footstep, GuardPresence, Noise, Rain, StaticDecoy, ThrownNoise,
+    corpse_rule, decoy_rule, footstep_rule, throw_rule, weather_rule,
 )
 from .errors import StimulusError
 from .plugins import ENTRY_POINT_GROUP, StimulusFactory, load_stimulus
-from .stimulus import DIRECTIONS, FieldContext, Measure, Rule, Sound, Stimulus, StimulusParams
+from .stimulus import (
+    DIRECTIONS, STIMULUS_TYPES, FieldContext, Measure, Rule, Sound, Stimulus, StimulusParams,
+    register_stimulus, unregister_stimulus,
+)
 from .view import Event, GuardAI, WorldView
 from .zones import Zone, apply_zones, zone_view_scale, zones_from_config
 
@@ -79,10 +82,12 @@ class StimulusSet:
         rng: np.random.Generator | None = None,
         zones: Mapping[str, np.ndarray] | None = None,
         rules: Mapping[str, Rule] | None = None,
+        config: Mapping[str, Any] | None = None,
     ) -> None:
         self.ctx = FieldContext(
             graph, params or StimulusParams(),
             rng if rng is not None else np.random.default_rng(0), dict(zones or {}),
+            config=config if config is not None else {},
         )
         self.rules: dict[str, Rule] = dict(DEFAULT_RULES if rules is None else rules)
         self.guard_ai = guard_ai
@@ -200,9 +205,11 @@ class StimulusSet:
 __all__ = [
     "DEFAULT_RULES",
     "DIRECTIONS",
+    "STIMULUS_TYPES",
     "ENTRY_POINT_GROUP",
     "Corpse",
     "FieldContext",
+    "Footstep",
     "GuardPresence",
     "Measure",
     "Noise",
@@ -211,6 +218,7 @@ __all__ = [
     "Sound",
     "StaticDecoy",
     "Stimulus",
+    "ThrownNoise",
     "StimulusError",
     "StimulusFactory",
     "StimulusParams",
@@ -221,7 +229,9 @@ __all__ = [
     "decoy_rule",
     "footstep_rule",
     "load_stimulus",
+    "register_stimulus",
     "throw_rule",
+    "unregister_stimulus",
     "weather_rule",
     "zone_view_scale",
     "zones_from_config",

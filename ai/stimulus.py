@@ -2,21 +2,23 @@
 
 A :class:`Stimulus` knows how it injects into the information field, how it decays and when
 it ends; it sees the trial through a :class:`FieldContext` and declares how
-``stealth mechanics --stimulus`` measures it (:class:`Measure`). The built-in mechanics are in
+``stealth mechanics --stimulus`` measures it (:class:`Measure`). Its class declares its
+names and its own config parameters, and :data:`STIMULUS_TYPES` holds the classes known by
+name (the built-ins, the plugins loaded). The built-in mechanics are in
 :mod:`ai.builtin_stimuli`, the set that drives them in :mod:`ai.stimuli`.
 """
 
 from __future__ import annotations
 
 from collections.abc import Callable, Iterable, Mapping
-from dataclasses import dataclass, field
-from typing import Any, NamedTuple
+from dataclasses import dataclass, field, is_dataclass
+from typing import Any, ClassVar, NamedTuple
 
 import numpy as np
 
 from navmesh.graph import UNREACHABLE_HOPS, NodeGraph
 
-from . import plugin_call
+from . import plugin_call, registrations
 from .errors import StimulusError
 from .bounds import COUNT, FLAG, FRACTION, NON_NEGATIVE, UNIT
 from .params import _Params
@@ -97,7 +99,9 @@ class FieldContext:
     """What a stimulus may read about its trial: the graph, the parameters, the time.
 
     ``active`` is the set's current stimuli (weather consults it for :meth:`sound`); ``rng``
-    is a generator derived from the trial's seed, for stimuli that need randomness.
+    is a generator derived from the trial's seed, for stimuli that need randomness;
+    ``config`` the trial's config values by dotted key, from which :meth:`params_of` builds
+    a plugin's own parameters.
     """
 
     graph: NodeGraph
@@ -106,10 +110,41 @@ class FieldContext:
     zones: Mapping[str, np.ndarray] = field(default_factory=dict)
     t: float = 0.0
     active: tuple[Stimulus, ...] = ()
+    config: Mapping[str, Any] = field(default_factory=dict)
 
     @property
     def n(self) -> int:
         return self.graph.n
+
+    def params_of(self, stimulus: Stimulus) -> Any:
+        """``stimulus``'s parameters (an instance of its :attr:`Stimulus.parameters`) with this
+        trial's values of its config section (``--set SECTION.KEY=V``, a preset's ``[set]``);
+        the class's defaults where the config has none.
+
+        >>> from dataclasses import dataclass
+        >>> from ai.bounds import NON_NEGATIVE
+        >>> @dataclass(frozen=True)
+        ... class BellParams(_Params):
+        ...     amplitude: float = 6.0
+        ...     bounds = {"amplitude": NON_NEGATIVE}
+        >>> class Bell(Stimulus):
+        ...     name, parameters = "bell", BellParams
+        >>> ctx = FieldContext(NodeGraph.from_grid(np.ones((1, 2), bool), 1.0),
+        ...                    config={"bell.amplitude": 2.5})
+        >>> ctx.params_of(Bell()).amplitude, Bell.section, Bell.display
+        (2.5, 'bell', 'bell')
+        """
+        cls = stimulus.parameters
+        if cls is None:
+            raise StimulusError(f"{plugin_call.describe(stimulus)}: declares no parameters")
+        prefix = stimulus.section + "."
+        given = {k[len(prefix):]: v for k, v in self.config.items()
+                 if k.startswith(prefix) and "." not in k[len(prefix):]}
+        try:
+            return cls.from_mapping(given)
+        except (TypeError, ValueError) as error:
+            raise StimulusError(f"{plugin_call.describe(stimulus)}: [{stimulus.section}]: "
+                                f"{error}") from None
 
     def hops_from(self, node: int, max_hops: int | None = None) -> np.ndarray:
         """Hop distance (BFS) from ``node`` to every node (a huge number where unreachable or,
@@ -207,7 +242,17 @@ class Stimulus:
     ``node`` is where it is (``-1``: nowhere in particular); stimuli with ``marker`` set are
     drawn by the game and raise ``"guard_on"`` events when a guard steps onto their node.
 
-    Two declarations concern a plugin as a whole:
+    What the rest of the house reads of a mechanic is declared on its class:
+
+    * :attr:`name` — its name in traces; :attr:`display` the name tables print and
+      :attr:`short` the one dense text prints (default: the name, then the display name).
+    * :attr:`parameters` — its parameter dataclass (an :class:`ai.params._Params` with
+      ``bounds``; ``None``: none) whose fields are the keys of config section
+      :attr:`section` (default: the name). Loading a plugin registers them
+      (:func:`register_stimulus`), so ``--set SECTION.KEY=V`` and presets set them and the
+      stimulus reads them with :meth:`FieldContext.params_of`.
+
+    Two more declarations concern a plugin as a whole:
 
     * :attr:`zone_kinds` — the level zone kinds the mechanic gives meaning to (e.g.
       ``("alarm",)``). Loading the plugin (:func:`load_stimulus`) registers each with
@@ -218,6 +263,10 @@ class Stimulus:
     """
 
     name: str = "stimulus"
+    display: ClassVar[str] = "stimulus"
+    short: ClassVar[str] = "stimulus"
+    parameters: ClassVar[type[_Params] | None] = None
+    section: ClassVar[str] = "stimulus"
     node: int = -1
     marker: bool = False
     zone_kinds: tuple[str, ...] = ()
@@ -227,6 +276,18 @@ class Stimulus:
     decoy: int = -1
     done: bool = False
     information_weight_floor: float | None = None
+
+    def __init_subclass__(cls, **kwargs: Any) -> None:
+        """A subclass that names itself but not its display name, short name or section
+        takes its name for each (the short name: its display name)."""
+        super().__init_subclass__(**kwargs)
+        own = vars(cls)
+        if "display" not in own:
+            cls.display = str(cls.name)
+        if "short" not in own:
+            cls.short = cls.display
+        if "section" not in own:
+            cls.section = str(cls.name)
 
     def start(self, ctx: FieldContext) -> None:
         """Join a trial (default: nothing)."""
@@ -259,6 +320,63 @@ class Stimulus:
     def describe(self) -> dict[str, Any]:
         """A JSON-able summary for traces."""
         return {"name": self.name, "node": int(self.node)}
+
+
+# ---------------------------------------------------------------------------- the registry
+
+#: Every stimulus class known by its :attr:`~Stimulus.name`: the built-in mechanics
+#: (:mod:`ai.builtin_stimuli`), then each plugin as :func:`ai.plugins.load_stimulus` loads
+#: it. The config's sections of their :attr:`~Stimulus.parameters` (``game.schema``) and
+#: the trace reader's markers (``game.trace``) read it.
+STIMULUS_TYPES: dict[str, type[Stimulus]] = {}
+
+
+def register_stimulus(cls: type[Stimulus]) -> type[Stimulus]:
+    """Make stimulus class ``cls`` known by its name (a plugin loaded again replaces its
+    older self) and return it. Refuses (:class:`StimulusError`) parameters that are no
+    :class:`~ai.params._Params` dataclass with a bound for every field and defaults within
+    them, or a section that holds a guard mode's, a player policy's or another stimulus's
+    parameters.
+    """
+    name = cls.name
+    if not isinstance(name, str) or not name:
+        raise StimulusError(f"{cls.__name__}: name must be a non-empty string, got {name!r}")
+    for attr in ("display", "short", "section"):
+        if not isinstance(getattr(cls, attr), str) or not getattr(cls, attr):
+            raise StimulusError(f"{name}: {attr} must be a non-empty string")
+    params = cls.parameters
+    if params is not None:
+        _check_parameters(cls, params)
+    STIMULUS_TYPES[name] = cls
+    return cls
+
+
+def _check_parameters(cls: type[Stimulus], params: Any) -> None:
+    name, section = cls.name, cls.section
+    if not (isinstance(params, type) and issubclass(params, _Params) and is_dataclass(params)):
+        raise StimulusError(f"{name}: parameters must be a dataclass subclass of "
+                            f"ai.params._Params, got {params!r}")
+    unbounded = [k for k in params.config_defaults() if k not in params.bounds]
+    if unbounded:
+        raise StimulusError(f"{name}: parameters {params.__name__}.{unbounded[0]} declares "
+                            "no bound (its bounds maps each field to its allowed values)")
+    try:
+        params()
+    except (TypeError, ValueError) as error:
+        raise StimulusError(f"{name}: parameters {params.__name__}: {error}") from None
+    taken = [f"{r.name!r}" for r in registrations() if r.section == section]
+    taken += [f"stimulus {other.name!r}" for other in STIMULUS_TYPES.values()
+              if other.section == section and other.parameters is not None
+              and other.name != name]
+    if taken:
+        raise StimulusError(f"{name}: config section [{section}] already holds the parameters "
+                            f"of {taken[0]}; declare a section of its own")
+
+
+def unregister_stimulus(name: str) -> None:
+    """Forget the stimulus class registered as ``name`` (tests, notebooks): its config
+    section is gone from configs made afterwards."""
+    STIMULUS_TYPES.pop(name, None)
 
 
 # ---------------------------------------------------------------------------- event rules

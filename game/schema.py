@@ -5,7 +5,8 @@ defaults as defaults and its ``bounds`` (:mod:`ai.bounds`) as allowed values
 (:func:`parameter_sections`): each registered guard mode and player policy brings its own
 (``ai.register_guard_mode(..., params=, section=)``: ``[pf]`` is
 :class:`~ai.params.PFParams`, ``[fsm]`` / ``[staleness]`` the FSM classes, ``[player]``
-:class:`~ai.params.PlayerParams`), and the world's are ``[stimuli]``
+:class:`~ai.params.PlayerParams`), so does each loaded plugin stimulus that declares
+``parameters`` (``[its section]``), and the world's are ``[stimuli]``
 (:class:`~ai.stimuli.StimulusParams` plus :class:`~game.action_params.ActionParams`) and the four
 switchable team rules. The keys no dataclass holds — ``[world]``, ``[scenario.*]``,
 ``[zones]`` (:class:`~ai.stimuli.Zone` per zone kind), ``[metrics]`` and the team rules'
@@ -34,7 +35,7 @@ from ai.awareness import AwarenessParams
 from ai.params import PlayerParams, _Params
 from ai.radio import RadioParams
 from ai.roles import RoleParams
-from ai.stimuli import StimulusParams, Zone, zones_from_config
+from ai.stimuli import STIMULUS_TYPES, StimulusParams, Zone, zones_from_config
 from navmesh.clearance import check_body
 from navmesh.level import ZONE_KINDS
 
@@ -135,9 +136,13 @@ _Registered = tuple[tuple[str, str, type[_Params]], ...]
 
 
 def registered_params() -> _Registered:
-    """``(section, name, params class)`` of every registration that has parameters."""
-    return tuple((r.section, r.name, cls) for r in registrations()
-                 if (cls := r.parameters()) is not None)
+    """``(section, name, params class)`` of every registration that has parameters: the
+    guard modes' and player policies', then the loaded plugin stimuli's
+    (:attr:`ai.stimuli.Stimulus.parameters`)."""
+    return (*((r.section, r.name, cls) for r in registrations()
+              if (cls := r.parameters()) is not None),
+            *((s.section, s.name, cls) for s in STIMULUS_TYPES.values()
+              if (cls := s.parameters) is not None))
 
 
 @functools.cache

@@ -20,6 +20,7 @@ from pathlib import Path
 from typing import IO, TYPE_CHECKING, Any
 
 from ai.plugin_call import call
+from ai.stimuli import STIMULUS_TYPES
 from navmesh.files import FileRefused, read_regular
 from navmesh.level import LEVELS_DIR, Level
 
@@ -200,6 +201,15 @@ def _object(value: Any, where: str) -> dict[str, Any]:
     return value
 
 
+def _drawn(name: Any) -> bool:
+    """Whether a traced stimulus that sits on a node is drawn there: its class's
+    :attr:`~ai.stimuli.Stimulus.marker` when a class of that name is known
+    (:data:`~ai.stimuli.STIMULUS_TYPES`: the built-ins, the plugins loaded); one this
+    process does not know (a plugin not loaded) is drawn, as it may be a marker."""
+    declared = STIMULUS_TYPES.get(name) if isinstance(name, str) else None
+    return True if declared is None else bool(declared.marker)
+
+
 def parse_line(record: Any, where: str) -> TraceLine:
     """Validate one decoded trace line."""
     record = _object(record, where)
@@ -238,7 +248,7 @@ def parse_line(record: Any, where: str) -> TraceLine:
     markers = tuple(
         int(st["node"]) for st in record.get("stimuli", []) or []
         if isinstance(st, dict) and isinstance(st.get("node"), int) and not isinstance(st["node"], bool)
-        and st["node"] >= 0 and st.get("name") not in ("footstep", "rain")
+        and st["node"] >= 0 and _drawn(st.get("name"))
     ) if isinstance(record.get("stimuli", []), list) else ()
     return TraceLine(
         markers=markers,

@@ -101,9 +101,9 @@ def make_world(
     spec (:func:`trial_rngs`); ``world_kwargs`` go to :class:`World` (``graph``,
     ``interactive``, ``stimuli``).
     """
-    config = config or Config.load(spec.settings)
     if spec.stimuli:  # first: loading a plugin registers the zone kinds its level may use
         world_kwargs.setdefault("stimuli", [load_stimulus(s) for s in spec.stimuli])
+    config = config or Config.load(spec.settings)  # and its parameters' config section
     if level is None:
         level = cached_level(spec.level)
     if controllers is None:
@@ -163,7 +163,7 @@ def run_trial(
     """
     started = time.perf_counter()
     if world is None:
-        world = make_world(spec, Config.load(spec.settings))
+        world = make_world(spec)
     config = world.config
     writer = attach_trace(world, trace, explain=explain) if trace is not None else None
     metrics = world.run()

@@ -132,7 +132,8 @@ class World(PlayerActions):
         # Stimuli (ai.stimuli): world events become field layers for the guard AI's hooks.
         apply_zones(self.guard_ai, self.zone_rules, self.zones)
         self.stimuli = StimulusSet(self.graph, self.stimulus_params, guard_ai=self.guard_ai,
-                                   rng=spawn_rng.spawn(1)[0], zones=self.zones)
+                                   rng=spawn_rng.spawn(1)[0], zones=self.zones,
+                                   config=config.as_dict())
         self.init_actions(level, raining=self.stimulus_params.raining)
         for factory in stimuli:
             self.stimuli.add(factory())

@@ -357,6 +357,8 @@ def parse_preset(
     if isinstance(root_seed, bool) or not isinstance(root_seed, int) or SEED.problem(root_seed):
         raise _fail(src, "root_seed", f"{root_seed!r}: {SEED.problem(root_seed)}")
 
+    # before the [set] and the levels, which may use their parameters and zone kinds
+    stimuli = _stimuli(data, src, base)
     overrides_table = data.get("set", {})
     if not isinstance(overrides_table, Mapping):
         raise _fail(src, "set", "expected a table of config overrides (dotted keys)")
@@ -394,7 +396,6 @@ def parse_preset(
             raise _fail(src, "players", f"{policy}: cannot be loaded "
                                         f"({type(error).__name__}: {error})") from None
 
-    stimuli = _stimuli(data, src, base)  # before the levels, which may use their zone kinds
     level_names = _names(data, "levels", src, None)
     refs: list[str] = []
     names: list[str] = []

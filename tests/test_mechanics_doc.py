@@ -79,3 +79,30 @@ def test_bad_stimulus_specs_are_one_line_errors(spec: str):
     assert result.returncode == 2 and result.stdout == ""
     assert len(result.stderr.strip().splitlines()) == 1
     assert result.stderr.startswith("stealth: error: ")
+
+
+def test_the_siren_block_is_the_shipped_example_and_its_parameter_reaches_it(tmp_path: Path):
+    """docs/mechanics.md "A plugin's own parameters": the block, its key, its bound."""
+    from ai.stimuli import STIMULUS_TYPES
+    from game.config import Config
+    from game.errors import ConfigError
+    from game.trial import TrialSpec, make_world
+
+    blocks = re.findall(r"```python\n(.*?)```", DOC.read_text(encoding="utf-8"), flags=re.DOTALL)
+    found = [b for b in blocks if "class Siren(" in b]
+    assert found == [(ROOT / "examples" / "siren.py").read_text(encoding="utf-8")]
+    plugin = tmp_path / "siren.py"
+    plugin.write_text(found[0], encoding="utf-8")
+    before = dict(STIMULUS_TYPES)
+    try:
+        pulls = []
+        for amplitude in (None, 2.0):
+            given = () if amplitude is None else (("siren.amplitude", amplitude),)
+            spec = TrialSpec("miami", stimuli=(f"{plugin}:Siren",), overrides=given)
+            pulls.append(float(make_world(spec).guard_ai.extra_information.min()))
+        assert pulls == [-6.0, -2.0]
+        with pytest.raises(ConfigError, match=r"siren\.falloff = 1\.5: must be in \(0, 1\]"):
+            Config.load(["siren.falloff=1.5"])
+    finally:
+        STIMULUS_TYPES.clear()
+        STIMULUS_TYPES.update(before)

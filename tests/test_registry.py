@@ -6,6 +6,7 @@ These are the two rows of docs/architecture.md's "to add X, touch Y" table done 
 from __future__ import annotations
 
 import ast
+import json
 from collections.abc import Iterator, Mapping
 from dataclasses import dataclass
 from pathlib import Path
@@ -21,7 +22,7 @@ from game.errors import ConfigError
 from ai import (
     GUARD_MODES, GuardAI, guard_mode, make_guard_ai, register_guard_mode, unregister_guard_mode,
 )
-from ai.errors import UnknownNameError
+from ai.errors import StimulusError, UnknownNameError
 from game.config import Config
 from game.scene import OVERLAYS, Overlay, SceneBuilder, overlay_key, register_overlay, \
     unregister_overlay
@@ -224,3 +225,147 @@ def test_no_mode_name_is_written_again_outside_the_registry() -> None:
              if s in BUILT_IN and s != "random"}
     assert {f for f, _, _ in found} <= set(CHOOSE_A_MODE), sorted(found)
     assert set(GUARD_MODES) >= set(BUILT_IN[:5])
+
+
+# ------------------------------------------- a plugin stimulus brings its parameters and names
+
+
+BELL = '''
+from dataclasses import dataclass
+
+from ai.bounds import NON_NEGATIVE
+from ai.params import _Params
+from ai.stimuli import Stimulus
+
+
+@dataclass(frozen=True)
+class BellParams(_Params):
+    amplitude: float = 6.0
+    bounds = {"amplitude": NON_NEGATIVE}
+
+
+class Bell(Stimulus):
+    name, display, short = "bell", "Alarm bell", "B"
+    parameters = BellParams
+
+    def start(self, ctx):
+        self.amplitude = ctx.params_of(self).amplitude
+        self.layer = -self.amplitude * ctx.falloff(0, 0.5)
+
+    def inject(self, ctx):
+        return self.layer
+
+    def describe(self):
+        return {"name": self.name, "node": -1, "amplitude": self.amplitude}
+
+
+class Plain(Stimulus):
+    name = "plain"
+
+    def inject(self, ctx):
+        return -1.0 * ctx.falloff(0, 0.5)
+
+
+class Beacon(Stimulus):  # sits on node 0; drawn there as declared
+    name, node, marker = "beacon", 0, True
+
+
+class Hum(Stimulus):  # sits on node 0, not drawn
+    name, node = "hum", 0
+
+
+@dataclass(frozen=True)
+class NoBound(_Params):
+    x: float = 1.0
+
+
+class Unbounded(Stimulus):
+    name, parameters = "unbounded", NoBound
+
+
+class OnPf(Stimulus):
+    name, section, parameters = "onpf", "pf", BellParams
+'''
+
+
+@pytest.fixture
+def bell(tmp_path: Path) -> Iterator[Path]:
+    """The plugin file; the stimulus classes it registers are forgotten afterwards."""
+    from ai.stimuli import STIMULUS_TYPES
+
+    before = dict(STIMULUS_TYPES)
+    path = tmp_path / "bell.py"
+    path.write_text(BELL, encoding="utf-8")
+    try:
+        yield path
+    finally:
+        STIMULUS_TYPES.clear()
+        STIMULUS_TYPES.update(before)
+
+
+def test_a_plugin_stimulus_takes_its_parameters_from_the_config(bell: Path, capsys) -> None:
+    from ai.stimuli import STIMULUS_TYPES
+    from headless.cli import main
+
+    trace = bell.with_name("bell.jsonl")
+    assert main(["sim", "maze", "--seed", "1", "--stimulus", f"{bell}:Bell",
+                 "--set", "bell.amplitude=2.5", "--set", "world.duration=2",
+                 "--trace", str(trace)]) == 0
+    first = json.loads(trace.read_text(encoding="utf-8").splitlines()[0])
+    assert first["stimuli"] == [{"name": "bell", "node": -1, "amplitude": 2.5}]
+    declared = STIMULUS_TYPES["bell"]
+    assert (declared.display, declared.short, declared.section) == ("Alarm bell", "B", "bell")
+    # the key's default and bound come from the class; the value reaches the stimulus
+    assert Config.defaults()["bell.amplitude"] == 6.0
+    for value, layer in ((None, -6.0), (0.0, 0.0), (1.5, -1.5)):
+        spec = TrialSpec("maze", seed=1, stimuli=(f"{bell}:Bell",),
+                         overrides=() if value is None else (("bell.amplitude", value),))
+        assert make_world(spec).guard_ai.extra_information[0] == layer
+    # an out-of-range value is one line, exit code 2
+    capsys.readouterr()
+    assert main(["sim", "maze", "--stimulus", f"{bell}:Bell", "--set", "bell.amplitude=-1"]) == 2
+    err = capsys.readouterr().err
+    assert err == "stealth: error: bell.amplitude = -1.0: must be in [0, inf)\n"
+    # a plugin without parameters works as before and adds no config key
+    keys = set(Config.defaults().as_dict())
+    plain = TrialSpec("maze", seed=1, stimuli=(f"{bell}:Plain",))
+    assert make_world(plain).guard_ai.extra_information[0] == -1.0
+    assert set(Config.defaults().as_dict()) == keys
+    assert not any(k.startswith("plain.") for k in keys)
+
+
+def test_a_preset_sets_a_plugin_parameter(bell: Path) -> None:
+    from headless.presets import load_preset
+
+    preset_file = bell.with_name("bell.toml")
+    preset_file.write_text(
+        'description = "bell"\nlevels = ["maze"]\nabstractions = ["grid"]\nguards = ["pf"]\n'
+        'players = ["maxmin"]\nscenarios = ["capture"]\nseeds = 1\nstimuli = ["bell.py:Bell"]\n'
+        '[set]\n"bell.amplitude" = 0.5\n', encoding="utf-8")
+    spec = load_preset(str(preset_file)).specs()[0]
+    assert make_world(spec).guard_ai.extra_information[0] == -0.5
+
+
+def test_bad_parameter_declarations_are_one_line_errors(bell: Path) -> None:
+    from ai.stimuli import load_stimulus
+
+    with pytest.raises(StimulusError, match=r"unbounded: parameters NoBound\.x declares no bound"):
+        load_stimulus(f"{bell}:Unbounded")
+    with pytest.raises(StimulusError, match=r"onpf: config section \[pf\] already holds the "
+                                            "parameters of 'pf'"):
+        load_stimulus(f"{bell}:OnPf")
+
+
+def test_the_replay_draws_what_the_stimulus_declares_a_marker(bell: Path) -> None:
+    from ai.stimuli import STIMULUS_TYPES
+    from game.trace import parse_line, trace_record
+
+    world = make_world(TrialSpec("maze", seed=1, stimuli=(f"{bell}:Beacon", f"{bell}:Hum")))
+    record = json.loads(json.dumps(trace_record(world)))
+    assert [s["name"] for s in record["stimuli"]] == ["beacon", "hum"]
+    assert parse_line(record, "line 1").markers == (0,)  # the beacon's: a hum is not drawn
+    del STIMULUS_TYPES["hum"]  # a plugin this process did not load may be a marker: drawn
+    assert parse_line(record, "line 1").markers == (0, 0)
+    # the built-ins answer the same question: footsteps and rain are not drawn, throws are
+    assert [STIMULUS_TYPES[n].marker for n in ("footstep", "rain", "thrown_decoy", "decoy",
+                                               "corpse")] == [False, False, True, True, True]

@@ -32,12 +32,15 @@ from typing import Any
 
 import numpy as np
 
-from ai.stimuli import footstep_rule
+from ai.stimuli import Corpse, Footstep, Rain, StaticDecoy, footstep_rule
 from ai.view import Action, Event
 from game.world import World
 
 from .beyond import AI_EXPECTED, AI_MECHANICS
 from .worlds import BLIND, Measures, WanderPlayer, active_guard_nodes, make_world, run_until
+
+#: the names of the measured stimuli as their classes declare them: each measure's prefix
+DECOY, FOOTSTEP, CORPSE, RAIN = (kind.short for kind in (StaticDecoy, Footstep, Corpse, Rain))
 
 BOOTSTRAP = 2000
 
@@ -68,8 +71,8 @@ def decoy(level: str, abstraction: str, seed: int) -> Measures:
         run_until(world, horizon, watch)
         out.append((float(bool(arrival)), arrival[0] if arrival else horizon))
     return {
-        "decoy: a guard reaches it within 15 s (share)": {"on": out[0][0], "control": out[1][0]},
-        "decoy: time to arrive, s (censored at 15)": {"on": out[0][1], "control": out[1][1]},
+        f"{DECOY}: a guard reaches it within 15 s (share)": {"on": out[0][0], "control": out[1][0]},
+        f"{DECOY}: time to arrive, s (censored at 15)": {"on": out[0][1], "control": out[1][1]},
     }
 
 
@@ -83,7 +86,7 @@ def footstep(level: str, abstraction: str, seed: int) -> Measures:
         world.perform(Action("sprint" if sprint else "walk"))
         run_until(world, horizon)
         values.append(float(world.metrics()["avg_guard_player_dist"]))
-    return {"footstep: mean nearest guard-player distance, units":
+    return {f"{FOOTSTEP}: mean nearest guard-player distance, units":
             {"on": values[0], "control": values[1]}}
 
 
@@ -107,7 +110,7 @@ def corpse(level: str, abstraction: str, seed: int) -> Measures:
             if w.step_index % w.steps_per_tick:
                 return
             track.append(float(np.min(w.graph.hops_between(active_guard_nodes(w), body))))
-            present = any(s.name == "corpse" for s in w.stimuli.active)
+            present = any(isinstance(s, Corpse) for s in w.stimuli.active)
             if on and present:
                 found[0] = True
             elif on and found[0] and not present and removal is None:
@@ -118,14 +121,14 @@ def corpse(level: str, abstraction: str, seed: int) -> Measures:
     near = [float(np.any(t[:20] <= 1)) for t in tracks]
     mean20 = [float(t[:20].mean()) for t in tracks]
     result = {
-        "corpse: a guard within 1 hop within 20 s (share)": {"on": near[0], "control": near[1]},
-        "corpse: mean nearest guard hops, first 20 s": {"on": mean20[0], "control": mean20[1]},
+        f"{CORPSE}: a guard within 1 hop within 20 s (share)": {"on": near[0], "control": near[1]},
+        f"{CORPSE}: mean nearest guard hops, first 20 s": {"on": mean20[0], "control": mean20[1]},
     }
     if removal is not None and removal + window <= horizon:
         k = round(removal) - 1  # index of the removal tick
         change = [float(t[k + 1: k + 1 + window].mean() - t[max(0, k - window) + 1: k + 1].mean())
                   for t in tracks]
-        result["corpse: nearest hops, 10 s after removal minus 10 s before"] = {
+        result[f"{CORPSE}: nearest hops, 10 s after removal minus 10 s before"] = {
             "on": change[0], "control": change[1]}
     return result
 
@@ -224,37 +227,37 @@ def rain(level: str, abstraction: str, seed: int) -> Measures:
     }
     share = {arm: float(np.nanmean(values)) if not np.all(np.isnan(values)) else math.nan
              for arm, values in curve.items()}
-    result["rain: share of footsteps 1-8 hops away that draw a guard"] = {
+    result[f"{RAIN}: share of footsteps 1-8 hops away that draw a guard"] = {
         "on": share["on"], "control": share["control"]}
-    result["footstep: share of single footsteps 1-8 hops away that draw a guard"] = {
+    result[f"{FOOTSTEP}: share of single footsteps 1-8 hops away that draw a guard"] = {
         "on": share["control"], "control": share["baseline"]}
     return result
 
 
 MECHANICS: dict[str, Callable[[str, str, int], Measures]] = {
-    "decoy": decoy,
-    "footstep": footstep,
-    "corpse": corpse,
+    DECOY: decoy,
+    FOOTSTEP: footstep,
+    CORPSE: corpse,
     "dark": dark,
     "concealment": concealment,
-    "rain": rain,
+    RAIN: rain,
     **AI_MECHANICS,  # beyond the paper: perception, alert, radio, roles (headless/mechanics_ai.py)
 }
 
 #: the direction each measure should move when the mechanic is on: +1 up, -1 down
 EXPECTED: dict[str, int] = {
-    "decoy: a guard reaches it within 15 s (share)": +1,
-    "decoy: time to arrive, s (censored at 15)": -1,
-    "footstep: mean nearest guard-player distance, units": -1,
-    "footstep: share of single footsteps 1-8 hops away that draw a guard": +1,
-    "corpse: a guard within 1 hop within 20 s (share)": +1,
-    "corpse: mean nearest guard hops, first 20 s": -1,
-    "corpse: nearest hops, 10 s after removal minus 10 s before": +1,
+    f"{DECOY}: a guard reaches it within 15 s (share)": +1,
+    f"{DECOY}: time to arrive, s (censored at 15)": -1,
+    f"{FOOTSTEP}: mean nearest guard-player distance, units": -1,
+    f"{FOOTSTEP}: share of single footsteps 1-8 hops away that draw a guard": +1,
+    f"{CORPSE}: a guard within 1 hop within 20 s (share)": +1,
+    f"{CORPSE}: mean nearest guard hops, first 20 s": -1,
+    f"{CORPSE}: nearest hops, 10 s after removal minus 10 s before": +1,
     "dark: visits per dark cell / per lit cell, 60 s": +1,
     "concealment: detected within 30 s (share)": -1,
     "concealment: time to first detection, s (censored at 30)": +1,
     "concealment: distance of the guard at first detection, units": -1,
-    "rain: share of footsteps 1-8 hops away that draw a guard": -1,
+    f"{RAIN}: share of footsteps 1-8 hops away that draw a guard": -1,
     **AI_EXPECTED,
 }
 
