@@ -28,7 +28,7 @@ from .errors import UnknownNameError
 from .view import Event, GuardAI, PlayerPolicy, WorldView
 
 if TYPE_CHECKING:
-    from .params import _Params
+    from .params import Params
 
 T = TypeVar("T", GuardAI, PlayerPolicy)
 
@@ -47,7 +47,7 @@ class Registration(Generic[T]):
 
     ``factory`` is a class (or any callable taking the params mapping) or a lazy
     ``"module:attr"`` reference, imported the first time the name is built. ``params`` is
-    its parameter dataclass (an :class:`ai.params._Params`, or a ``"module:attr"``
+    its parameter dataclass (an :class:`ai.params.Params`, or a ``"module:attr"``
     reference; ``None``: it takes none): its fields are the config keys of ``section``,
     their defaults the config's defaults, its ``bounds`` their allowed values. ``display``
     is the name tables and figures print, ``short`` the figures' tick label and ``abbrev``
@@ -60,19 +60,19 @@ class Registration(Generic[T]):
     section: str
     short: str
     abbrev: str
-    params: type[_Params] | str | None = None
+    params: type[Params] | str | None = None
 
     def build(self, params: Mapping[str, Any] | None = None) -> T:
         """A fresh controller with ``params``."""
         factory: Callable[[Mapping[str, Any] | None], T] = _resolve(self.factory)
         return factory(params)
 
-    def parameters(self) -> type[_Params] | None:
+    def parameters(self) -> type[Params] | None:
         """The parameter dataclass (imported on first use), or None."""
         return self._parameters
 
     @cached_property
-    def _parameters(self) -> type[_Params] | None:
+    def _parameters(self) -> type[Params] | None:
         return _resolve(self.params) if self.params is not None else None
 
 
@@ -94,7 +94,7 @@ PLAYER_POLICIES: dict[str, Registration[PlayerPolicy]] = {}
 
 def _registration(name: str, factory: Any, display: str | None, short: str | None,
                   abbrev: str | None, section: str,
-                  params: type[_Params] | str | None) -> Registration[Any]:
+                  params: type[Params] | str | None) -> Registration[Any]:
     """A registration with its names filled in; refuses a section that another
     registration fills with another parameter class (one section, one set of keys)."""
     for other in registrations():
@@ -111,7 +111,7 @@ def _registration(name: str, factory: Any, display: str | None, short: str | Non
 def register_guard_mode(name: str, factory: Callable[..., GuardAI] | str, *,
                         display: str | None = None, short: str | None = None,
                         abbrev: str | None = None, section: str | None = None,
-                        params: type[_Params] | str | None = None) -> None:
+                        params: type[Params] | str | None = None) -> None:
     """Register guard mode ``name``: its parameters ``params`` in config section ``section``
     (default ``name``), its names (display default ``name.title()``, short default the
     display name). A mode registered later comes later (play's next number key).
@@ -123,7 +123,7 @@ def register_guard_mode(name: str, factory: Callable[..., GuardAI] | str, *,
 def register_player_policy(name: str, factory: Callable[..., PlayerPolicy] | str, *,
                            display: str | None = None, short: str | None = None,
                            section: str = "player",
-                           params: type[_Params] | str | None = None) -> None:
+                           params: type[Params] | str | None = None) -> None:
     """Register player policy ``name`` (its parameters ``params`` in config section ``section``)."""
     PLAYER_POLICIES[name] = _registration(name, factory, display, short, None, section, params)
 

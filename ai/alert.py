@@ -35,7 +35,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from .bounds import FRACTION, NON_NEGATIVE, Range
-from .params import _Params
+from .params import Params
 from .stimuli import Stimulus
 from .view import Event, WorldView
 
@@ -46,7 +46,7 @@ _SPEED = Range(0.5, 1.5)
 
 
 @dataclass(frozen=True)
-class AlertParams(_Params):
+class AlertParams(Params):
     """The ``[alert]`` config section (``enabled`` is the world's switch, not a parameter)."""
 
     #: seconds after the last detection the team stays alert

@@ -41,7 +41,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .bounds import COUNT, NON_NEGATIVE, POSITIVE, UNIT
-from .params import _Params
+from .params import Params
 from .stimuli import FieldContext, Noise, Rule
 from .view import Event
 
@@ -51,7 +51,7 @@ EPS = 1e-9
 
 
 @dataclass(frozen=True)
-class AwarenessParams(_Params):
+class AwarenessParams(Params):
     """The ``[awareness]`` config section (``enabled`` is the world's switch)."""
 
     threshold: float = 1.0

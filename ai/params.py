@@ -27,13 +27,13 @@ from typing import Any, ClassVar, TypeVar
 
 from .bounds import ANY_NUMBER, COUNT, FLAG, FRACTION, NON_NEGATIVE, POSITIVE, UNIT, Bound, OneOf, Range
 
-_P = TypeVar("_P", bound="_Params")
+_P = TypeVar("_P", bound="Params")
 
-#: per parameter class, its config keys' defaults (:meth:`_Params.config_defaults`)
+#: per parameter class, its config keys' defaults (:meth:`Params.config_defaults`)
 _CONFIG_DEFAULTS: dict[type, Mapping[str, Any]] = {}
 
 
-class _Params:
+class Params:
     """Shared ``from_mapping`` and bound checks of the parameter dataclasses."""
 
     #: field name -> its allowed values (:mod:`ai.bounds`), one declaration per field; the
@@ -79,7 +79,7 @@ class _Params:
 
 
 @dataclass(frozen=True)
-class PFParams(_Params):
+class PFParams(Params):
     """Composite potential field guards (paper Table 2, SPEC §3)."""
 
     I0: float = 5.0  # noqa: N815 — the paper's symbol
@@ -141,7 +141,7 @@ node a guard sees (Al Enezi & Verbrugge 2020; docs/ai.md)."""
 
 
 @dataclass(frozen=True)
-class FSMParams(_Params):
+class FSMParams(Params):
     """FSM guards (paper Table 2; SPEC §4). Times in seconds."""
 
     info_threshold: float = 1.0  # information strength that triggers Investigate
@@ -191,7 +191,7 @@ class StalenessParams(FSMParams):
 
 
 @dataclass(frozen=True)
-class PlayerParams(_Params):
+class PlayerParams(Params):
     """Scripted players (SPEC §4). Speeds in world units per second, margins in seconds."""
 
     maxmin_depth: int = 3  # steps simulated ahead (≤ 5^depth sequences on the grid)
@@ -224,5 +224,5 @@ class PlayerParams(_Params):
     }
 
 
-__all__ = ["PFParams", "FSMParams", "StalenessParams", "PlayerParams", "INVESTIGATE_RULES",
+__all__ = ["Params", "PFParams", "FSMParams", "StalenessParams", "PlayerParams", "INVESTIGATE_RULES",
            "STALENESS_MODELS"]

@@ -38,13 +38,13 @@ from typing import Any
 import numpy as np
 
 from .bounds import FRACTION, NON_NEGATIVE, UNIT
-from .params import _Params
+from .params import Params
 from .stimuli import Corpse, FieldContext, Stimulus
 from .view import WorldView
 
 
 @dataclass(frozen=True)
-class RadioParams(_Params):
+class RadioParams(Params):
     """The ``[radio]`` config section (``enabled`` is the world's switch)."""
 
     #: world units between sender and hearer at sending time

@@ -44,13 +44,13 @@ import numpy as np
 from navmesh.graph import UNREACHABLE_HOPS, NodeGraph
 
 from .bounds import COUNT, NON_NEGATIVE, UNIT, Range
-from .params import _Params
+from .params import Params
 from .stimuli import FieldContext, Stimulus
 from .view import WorldView
 
 
 @dataclass(frozen=True)
-class RoleParams(_Params):
+class RoleParams(Params):
     """The ``[roles]`` config section (``enabled`` is the world's switch)."""
 
     #: how many guards intercept and how many hold chokepoints (the rest chase)

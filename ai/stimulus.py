@@ -21,7 +21,7 @@ from navmesh.graph import UNREACHABLE_HOPS, NodeGraph
 from . import plugin_call, registrations
 from .errors import StimulusError
 from .bounds import COUNT, FLAG, FRACTION, NON_NEGATIVE, UNIT
-from .params import _Params
+from .params import Params
 from .view import Event, WorldView
 
 
@@ -29,7 +29,7 @@ from .view import Event, WorldView
 
 
 @dataclass(frozen=True)
-class StimulusParams(_Params):
+class StimulusParams(Params):
     """The ``[stimuli]`` section of the config: the paper's values (SPEC §5) are the defaults.
 
     The section's player-action keys (``throw_cooldown``, ``throw_radius``, ``decoy_reach``,
@@ -124,7 +124,7 @@ class FieldContext:
         >>> from dataclasses import dataclass
         >>> from ai.bounds import NON_NEGATIVE
         >>> @dataclass(frozen=True)
-        ... class BellParams(_Params):
+        ... class BellParams(Params):
         ...     amplitude: float = 6.0
         ...     bounds = {"amplitude": NON_NEGATIVE}
         >>> class Bell(Stimulus):
@@ -246,7 +246,7 @@ class Stimulus:
 
     * :attr:`name` — its name in traces; :attr:`display` the name tables print and
       :attr:`short` the one dense text prints (default: the name, then the display name).
-    * :attr:`parameters` — its parameter dataclass (an :class:`ai.params._Params` with
+    * :attr:`parameters` — its parameter dataclass (an :class:`ai.params.Params` with
       ``bounds``; ``None``: none) whose fields are the keys of config section
       :attr:`section` (default: the name). Loading a plugin registers them
       (:func:`register_stimulus`), so ``--set SECTION.KEY=V`` and presets set them and the
@@ -265,7 +265,7 @@ class Stimulus:
     name: str = "stimulus"
     display: ClassVar[str] = "stimulus"
     short: ClassVar[str] = "stimulus"
-    parameters: ClassVar[type[_Params] | None] = None
+    parameters: ClassVar[type[Params] | None] = None
     section: ClassVar[str] = "stimulus"
     node: int = -1
     marker: bool = False
@@ -334,7 +334,7 @@ STIMULUS_TYPES: dict[str, type[Stimulus]] = {}
 def register_stimulus(cls: type[Stimulus]) -> type[Stimulus]:
     """Make stimulus class ``cls`` known by its name (a plugin loaded again replaces its
     older self) and return it. Refuses (:class:`StimulusError`) parameters that are no
-    :class:`~ai.params._Params` dataclass with a bound for every field and defaults within
+    :class:`~ai.params.Params` dataclass with a bound for every field and defaults within
     them, or a section that holds a guard mode's, a player policy's or another stimulus's
     parameters.
     """
@@ -353,9 +353,9 @@ def register_stimulus(cls: type[Stimulus]) -> type[Stimulus]:
 
 def _check_parameters(cls: type[Stimulus], params: Any) -> None:
     name, section = cls.name, cls.section
-    if not (isinstance(params, type) and issubclass(params, _Params) and is_dataclass(params)):
+    if not (isinstance(params, type) and issubclass(params, Params) and is_dataclass(params)):
         raise StimulusError(f"{name}: parameters must be a dataclass subclass of "
-                            f"ai.params._Params, got {params!r}")
+                            f"ai.params.Params, got {params!r}")
     unbounded = [k for k in params.config_defaults() if k not in params.bounds]
     if unbounded:
         raise StimulusError(f"{name}: parameters {params.__name__}.{unbounded[0]} declares "

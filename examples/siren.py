@@ -5,12 +5,12 @@
 from dataclasses import dataclass
 
 from ai.bounds import NON_NEGATIVE, UNIT
-from ai.params import _Params
+from ai.params import Params
 from ai.stimuli import Stimulus
 
 
 @dataclass(frozen=True)
-class SirenParams(_Params):
+class SirenParams(Params):
     amplitude: float = 6.0           # the keys siren.amplitude and siren.falloff,
     falloff: float = 0.85            # these their defaults
     bounds = {"amplitude": NON_NEGATIVE, "falloff": UNIT}

@@ -13,13 +13,13 @@ from dataclasses import dataclass, fields
 from typing import Any
 
 from ai.bounds import COUNT, NON_NEGATIVE, POSITIVE
-from ai.params import _Params
+from ai.params import Params
 
 __all__ = ["ActionParams"]
 
 
 @dataclass(frozen=True)
-class ActionParams(_Params):
+class ActionParams(Params):
     """Tunables of the player's actions; config keys ``stimuli.<name>`` (see the module)."""
 
     #: thrown decoy: seconds between throws, landing within this Manhattan radius in cells

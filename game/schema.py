@@ -32,7 +32,7 @@ from ai import registrations
 from ai.bounds import COUNT, FLAG, NON_NEGATIVE, POSITIVE, Bound, OneOf, Range
 from ai.alert import AlertParams
 from ai.awareness import AwarenessParams
-from ai.params import PlayerParams, _Params
+from ai.params import PlayerParams, Params
 from ai.radio import RadioParams
 from ai.roles import RoleParams
 from ai.stimuli import STIMULUS_TYPES, StimulusParams, Zone, zones_from_config
@@ -122,7 +122,7 @@ _TEAM_RULES: Mapping[str, Any] = {"awareness": AwarenessParams, "alert": AlertPa
                                   "radio": RadioParams, "roles": RoleParams}
 
 #: the world's parameter classes, by the section that holds their keys
-_WORLD_PARAMS: Mapping[str, tuple[type[_Params], ...]] = {
+_WORLD_PARAMS: Mapping[str, tuple[type[Params], ...]] = {
     "stimuli": (StimulusParams, ActionParams), **{k: (v,) for k, v in _TEAM_RULES.items()}}
 
 #: the sections no parameter class holds (defaults in game/defaults.toml, bounds above)
@@ -132,7 +132,7 @@ _FILE_SECTIONS: Mapping[str, Mapping[str, Bound]] = {
     "metrics": METRICS,
 }
 
-_Registered = tuple[tuple[str, str, type[_Params]], ...]
+_Registered = tuple[tuple[str, str, type[Params]], ...]
 
 
 def registered_params() -> _Registered:
@@ -146,8 +146,8 @@ def registered_params() -> _Registered:
 
 
 @functools.cache
-def _sections(registered: _Registered) -> dict[str, tuple[type[_Params], ...]]:
-    sections: dict[str, tuple[type[_Params], ...]] = {}
+def _sections(registered: _Registered) -> dict[str, tuple[type[Params], ...]]:
+    sections: dict[str, tuple[type[Params], ...]] = {}
     for section, name, cls in registered:
         if section in _FILE_SECTIONS or section in _WORLD_PARAMS or section.startswith("scenario"):
             raise ConfigError(f"{name}: config section [{section}] is the world's; register "
@@ -156,7 +156,7 @@ def _sections(registered: _Registered) -> dict[str, tuple[type[_Params], ...]]:
     return {**sections, **_WORLD_PARAMS}
 
 
-def parameter_sections() -> Mapping[str, tuple[type[_Params], ...]]:
+def parameter_sections() -> Mapping[str, tuple[type[Params], ...]]:
     """Config section -> the parameter dataclasses whose fields are its keys: the registered
     guard modes' and player policies' (registration order), then the world's.
 

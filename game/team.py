@@ -18,7 +18,7 @@ from typing import TYPE_CHECKING, Any, Protocol
 
 from ai.alert import AlertParams, AlertPhases
 from ai.awareness import Awareness, AwarenessParams, suspicion_rule
-from ai.params import _Params
+from ai.params import Params
 from ai.radio import Radio, RadioParams
 from ai.roles import RoleParams, Roles
 from ai.stimuli import StimulusSet
@@ -36,7 +36,7 @@ if TYPE_CHECKING:
 SECTIONS = ("awareness", "alert", "radio", "roles")
 
 
-def _params(config: Any, section: str, cls: type[_Params]) -> Any | None:
+def _params(config: Any, section: str, cls: type[Params]) -> Any | None:
     """``cls`` from the section without its switch, or None when the switch is off."""
     values = config.section(section)
     if not values.pop("enabled", False):

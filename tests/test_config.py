@@ -7,16 +7,16 @@ from dataclasses import fields
 
 import pytest
 
-from ai.params import PlayerParams, _Params
+from ai.params import PlayerParams, Params
 from game.config import DEFAULTS_PATH, Config, ConfigError
 from game.schema import parameter_sections
 
 
 def _params_classes() -> set[type]:
-    """Every parameter dataclass of the product (ai/, game/): subclasses of ``_Params``."""
+    """Every parameter dataclass of the product (ai/, game/): subclasses of ``Params``."""
     import ai.alert, ai.awareness, ai.radio, ai.roles, ai.stimuli, game.actions  # noqa: E401, F401
 
-    found, todo = set(), [_Params]
+    found, todo = set(), [Params]
     while todo:
         for sub in todo.pop().__subclasses__():
             todo.append(sub)

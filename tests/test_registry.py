@@ -17,7 +17,7 @@ import pytest
 
 from ai.baselines import RandomWalkGuards
 from ai.bounds import POSITIVE
-from ai.params import PFParams, _Params
+from ai.params import PFParams, Params
 from game.errors import ConfigError
 from ai import (
     GUARD_MODES, GuardAI, guard_mode, make_guard_ai, register_guard_mode, unregister_guard_mode,
@@ -111,7 +111,7 @@ def test_a_registered_overlay_is_drawn_from_the_modes_fields(sentry: str) -> Non
 
 
 @dataclass(frozen=True)
-class PatrolParams(_Params):
+class PatrolParams(Params):
     """Test-only: one parameter, the patrol's pace."""
 
     speed: float = 1.0
@@ -234,12 +234,12 @@ BELL = '''
 from dataclasses import dataclass
 
 from ai.bounds import NON_NEGATIVE
-from ai.params import _Params
+from ai.params import Params
 from ai.stimuli import Stimulus
 
 
 @dataclass(frozen=True)
-class BellParams(_Params):
+class BellParams(Params):
     amplitude: float = 6.0
     bounds = {"amplitude": NON_NEGATIVE}
 
@@ -275,7 +275,7 @@ class Hum(Stimulus):  # sits on node 0, not drawn
 
 
 @dataclass(frozen=True)
-class NoBound(_Params):
+class NoBound(Params):
     x: float = 1.0
 
 
