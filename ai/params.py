@@ -34,7 +34,9 @@ _CONFIG_DEFAULTS: dict[type, Mapping[str, Any]] = {}
 
 
 class Params:
-    """Shared ``from_mapping`` and bound checks of the parameter dataclasses."""
+    """The base of every parameter dataclass (a guard mode's, a player policy's, a plugin
+    stimulus's: subclass it, frozen, with a ``bounds`` entry per field): ``from_mapping`` and
+    the bound checks."""
 
     #: field name -> its allowed values (:mod:`ai.bounds`), one declaration per field; the
     #: config schema (``game.schema``) reads these for the keys of the section
