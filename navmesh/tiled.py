@@ -176,7 +176,7 @@ def tiled_level_data(path: Path, source: str, raw: bytes | None = None
 
 
 def _put(data: dict[str, Any], field_name: str, value: Any) -> None:
-    """Set a field of the level structure; ``zones.dark`` is ``data["zones"]["dark"]``."""
+    """Set a field of the level structure; ``"zones.KIND"`` is ``data["zones"]["KIND"]``."""
     *parents, key = field_name.split(".")
     for parent in parents:
         data = data.setdefault(parent, {})
