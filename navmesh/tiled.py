@@ -47,13 +47,18 @@ from navmesh.errors import LevelError, LevelWarning
 from navmesh.level_format import Level, parse_level
 from navmesh.tiled_classes import OBSTACLE, OUTLINE, POINTS, POINT, WALLS, TiledClass, \
     object_classes
-from navmesh.tiled_guard import MAX_COORDINATE, MapFiles, check_map_cells
+from navmesh.tiled_guard import MapFiles, check_map_cells
 from navmesh.tiled_read import read_map
 
-__all__ = ["ELLIPSE_SIDES", "load_tiled", "tiled_level_data"]
+__all__ = ["ELLIPSE_SIDES", "MAX_TILE_PIXELS", "load_tiled", "tiled_level_data"]
 
 ELLIPSE_SIDES = 32
 """An ellipse object becomes this regular-angle polygon inscribed in it."""
+
+MAX_TILE_PIXELS = 2**16
+"""Widest tile read, in pixels. Objects are placed in pixels and a tile is a cell, so an
+object one pixel wide is 1/65536 of a cell here, an area the level's checks still tell from
+zero; with wider tiles an ordinary map's objects shrink to specks refused as "zero area"."""
 
 
 @dataclass
@@ -111,8 +116,9 @@ def tiled_level_data(path: Path, source: str, raw: bytes | None = None
     if tile_w != tile_h or tile_w <= 0:
         _fail(source, "map", f"tiles of {tile_w}x{tile_h} pixels are not supported; "
                              "tiles must be square")
-    if tile_w > MAX_COORDINATE:
-        _fail(source, "map", f"tiles wider than {MAX_COORDINATE} pixels are not supported")
+    if tile_w > MAX_TILE_PIXELS:
+        _fail(source, "map", f"tiles {tile_w} pixels wide are not supported; tiles are at "
+                             f"most {MAX_TILE_PIXELS} pixels wide")
     cell_size = _cell_size(tmap, source)
     found = _Collected({c.name: c for c in object_classes()})
     _collect(tmap.layers, "", 0.0, 0.0, found, source)
