@@ -45,8 +45,7 @@ from shapely.geometry import Polygon, box
 
 from navmesh.errors import LevelError, LevelWarning
 from navmesh.level_format import Level, parse_level
-from navmesh.tiled_classes import OBSTACLE, OUTLINE, POINTS, POINT, WALLS, TiledClass, \
-    object_classes
+from navmesh.tiled_classes import OBSTACLE, OUTLINE, WALLS, TiledClass, object_classes
 from navmesh.tiled_guard import MapFiles, check_map_cells
 from navmesh.tiled_read import read_map
 
@@ -168,7 +167,7 @@ def tiled_level_data(path: Path, source: str, raw: bytes | None = None
         if cls in (OBSTACLE, OUTLINE):
             continue
         objects = found.shapes.get(cls.name, [])
-        convert = _xy if cls.becomes in (POINTS, POINT) else _ring
+        convert = _ring if cls.is_area else _xy
         values = [convert(world(geometry)) for _, geometry in objects]
         if cls.single:
             if values:
@@ -355,8 +354,8 @@ def _object_geometry(
 
 
 def _warn_of_missing_parts(found: _Collected, tmap: pytiled_parser.TiledMap, src: str) -> None:
-    """One warning line for each class the map has no object of that says why it still loads
-    (no guards), one for a map that is an empty box."""
+    """One warning line for each class with a ``when_missing`` reason that the map has no
+    object of (guards), and one for a map that is an empty box."""
     for cls in found.classes.values():
         if cls.when_missing and not found.shapes.get(cls.name):
             _warn(src, "map", f"no object of class {cls.name!r}: {cls.when_missing}")
