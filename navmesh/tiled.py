@@ -9,22 +9,22 @@ Conventions (documented for level designers in ``docs/levels.md``):
 
 * one tile is one world unit, or ``cell_size`` units if the map has that number property;
   the grid is the map's tile grid;
-* blocked: every non-zero tile of a tile layer whose name or class is ``walls``, and every
-  object of class ``obstacle``; the outline is the map's bounds unless an ``outline``
-  object is given (an infinite map is cut to the bounds of its walls and obstacles, shifted
-  by whole tiles so that they start at the origin);
-* points (a point object, or the centre of any other shape): ``guard``, ``decoy``,
-  ``player``, ``collectible``; areas (rectangle, polygon, ellipse as a 32-gon, rotation
-  honoured): ``exit`` and every zone kind of :func:`navmesh.level.zone_kinds`.
+* the classes of layers and objects, and what each becomes, are those of
+  :mod:`navmesh.tiled_classes` (points: a point object, or the centre of any other shape;
+  areas: rectangle, polygon, ellipse as a 32-gon, rotation honoured);
+* blocked: the non-zero tiles of the walls layers and the obstacle objects; the outline is
+  the map's bounds unless an outline object is given (an infinite map is cut to the bounds
+  of its walls and obstacles, shifted by whole tiles so that they start at the origin).
 
 Object classes are matched on the object's ``class`` (Tiled >= 1.9) or legacy ``type``,
 case-insensitively; objects without a class are decoration and ignored, and so is an
 object of a class Stealthfield does not know, with one :class:`~navmesh.errors.LevelWarning`
 each (a published map has classes of its own game; a typo'd guard is named in that line).
-A map without guard objects also warns: its guards take the world's random spawns. A map
-without walls, obstacles or an outline warns that it is an empty box (an infinite one is
-cut to the bounds of all its tiles). Layer offsets count (those of enclosing groups added
-up); parallax, visibility and opacity are rendering matters and are ignored.
+A map without any object of a class that has a ``when_missing`` reason (guards: they take
+the world's random spawns) warns with it. A map without walls, obstacles or an outline
+warns that it is an empty box (an infinite one is cut to the bounds of all its tiles).
+Layer offsets count (those of enclosing groups added up); parallax, visibility and opacity
+are rendering matters and are ignored.
 """
 
 from __future__ import annotations
@@ -44,28 +44,28 @@ from pytiled_parser import tiled_object as to
 from shapely.geometry import Polygon, box
 
 from navmesh.errors import LevelError, LevelWarning
-from navmesh.level_fields import zone_kinds
 from navmesh.level_format import Level, parse_level
-from navmesh.tiled_guard import MAX_COORDINATE, MapFiles, check_map_cells
+from navmesh.tiled_classes import OBSTACLE, OUTLINE, WALLS, TiledClass, object_classes
+from navmesh.tiled_guard import MapFiles, check_map_cells
 from navmesh.tiled_read import read_map
 
-__all__ = ["ELLIPSE_SIDES", "load_tiled", "tiled_level_data"]
+__all__ = ["ELLIPSE_SIDES", "MAX_TILE_PIXELS", "load_tiled", "tiled_level_data"]
 
 ELLIPSE_SIDES = 32
 """An ellipse object becomes this regular-angle polygon inscribed in it."""
 
-WALLS = "walls"
-"""Name or class of the tile layers whose non-zero tiles are blocked."""
-
-_POINT_CLASSES = {"guard": "guards", "decoy": "decoys", "collectible": "collectibles"}
-_SINGLE_POINT_CLASSES = ("player",)
-_SHAPE_CLASSES = ("obstacle", "outline", "exit")
+MAX_TILE_PIXELS = 2**16
+"""Widest tile read, in pixels. Objects are placed in pixels and a tile is a cell, so an
+object one pixel wide is 1/65536 of a cell here, an area the level's checks still tell from
+zero; with wider tiles an ordinary map's objects shrink to specks refused as "zero area"."""
 
 
 @dataclass
 class _Collected:
     """What the layers hold, in map pixels (offsets applied), before conversion."""
 
+    classes: dict[str, TiledClass]
+    """The object classes known when the map is read, by name (zone kinds included)."""
     walls: list[tuple[str, np.ndarray, np.ndarray, float, float]] = field(default_factory=list)
     """(layer, tile columns, tile rows, offset x px, offset y px) of each walls layer."""
     shapes: dict[str, list[tuple[str, Any]]] = field(default_factory=dict)
@@ -115,19 +115,22 @@ def tiled_level_data(path: Path, source: str, raw: bytes | None = None
     if tile_w != tile_h or tile_w <= 0:
         _fail(source, "map", f"tiles of {tile_w}x{tile_h} pixels are not supported; "
                              "tiles must be square")
-    if tile_w > MAX_COORDINATE:
-        _fail(source, "map", f"tiles wider than {MAX_COORDINATE} pixels are not supported")
+    if tile_w > MAX_TILE_PIXELS:
+        _fail(source, "map", f"tiles {tile_w} pixels wide are not supported; tiles are at "
+                             f"most {MAX_TILE_PIXELS} pixels wide")
     cell_size = _cell_size(tmap, source)
-    found = _Collected()
+    found = _Collected({c.name: c for c in object_classes()})
     _collect(tmap.layers, "", 0.0, 0.0, found, source)
     tile = float(tile_w)
+    for cls in found.classes.values():
+        objects = found.shapes.get(cls.name, [])
+        if cls.single and len(objects) > 1:
+            _fail(source, objects[1][0], f"a second object of class {cls.name!r}; "
+                                         "a map has at most one")
     _warn_of_missing_parts(found, tmap, source)
 
     # Bounds in tiles: the map's, or for an infinite map those of its content.
-    outline_objects = found.shapes.get("outline", [])
-    if len(outline_objects) > 1:
-        _fail(source, outline_objects[1][0], "a second object of class 'outline'; "
-                                             "a map has at most one")
+    outline_objects = found.shapes.get(OUTLINE.name, [])
     if not tmap.infinite:
         x0, y0, x1, y1 = 0, 0, int(tmap.map_size.width), int(tmap.map_size.height)
     else:
@@ -142,7 +145,7 @@ def tiled_level_data(path: Path, source: str, raw: bytes | None = None
     data["cell_size"] = cell_size
     origins: dict[str, str] = {}
     aligned = all(ox % tile == 0 and oy % tile == 0 for _, _, _, ox, oy in found.walls)
-    obstacle_objects = found.shapes.get("obstacle", [])
+    obstacle_objects = found.shapes.get(OBSTACLE.name, [])
     walls_origin = ", ".join(f"layer {name!r}" for name, *_ in found.walls) or "map"
     if aligned and not obstacle_objects and not outline_objects:
         data["grid"] = _grid(found, (x0, y0, x1, y1), tile, source)
@@ -152,44 +155,37 @@ def tiled_level_data(path: Path, source: str, raw: bytes | None = None
             where, outline = outline_objects[0]
         else:
             where, outline = "map bounds", box(x0 * tile, y0 * tile, x1 * tile, y1 * tile)
-        data["outline"] = _ring(world(outline))
-        origins["outline"] = where
-        obstacles: list[list[list[float]]] = []
-        for where, geometry in obstacle_objects:
-            origins[f"obstacles[{len(obstacles)}]"] = where
-            obstacles.append(_ring(world(geometry)))
-        for where, geometry in _wall_rectangles(found, outline, tile):
-            origins[f"obstacles[{len(obstacles)}]"] = where
-            obstacles.append(_ring(world(geometry)))
-        data["obstacles"] = obstacles
+        data[OUTLINE.field] = _ring(world(outline))
+        origins[OUTLINE.field] = where
+        obstacles = [*obstacle_objects, *_wall_rectangles(found, outline, tile)]
+        data[OBSTACLE.field] = [_ring(world(geometry)) for _, geometry in obstacles]
+        origins.update((f"{OBSTACLE.field}[{i}]", where) for i, (where, _) in enumerate(obstacles))
         if not obstacles:
-            origins["obstacles"] = walls_origin
+            origins[OBSTACLE.field] = walls_origin
 
-    zones: dict[str, list[list[list[float]]]] = {}
-    for kind in zone_kinds():
-        for where, geometry in found.shapes.get(kind, []):
-            origins[f"zones.{kind}[{len(zones.setdefault(kind, []))}]"] = where
-            zones[kind].append(_ring(world(geometry)))
-    if zones:
-        data["zones"] = zones
-    for where, geometry in found.shapes.get("exit", []):
-        origins[f"exits[{len(data.setdefault('exits', []))}]"] = where
-        data["exits"].append(_ring(world(geometry)))
-    for cls, key in _POINT_CLASSES.items():
-        points = data.setdefault(key, []) if cls == "guard" else data.get(key, [])
-        for where, geometry in found.shapes.get(cls, []):
-            origins[f"{key}[{len(points)}]"] = where
-            points.append(_xy(world(geometry)))
-        if points:
-            data[key] = points
-    origins["guards"] = "objects of class 'guard'"
-    players = found.shapes.get("player", [])
-    if len(players) > 1:
-        _fail(source, players[1][0], "a second object of class 'player'; a map has at most one")
-    if players:
-        origins["player"] = players[0][0]
-        data["player"] = _xy(world(players[0][1]))
+    for cls in found.classes.values():  # the rest: points, exits, zones
+        if cls in (OBSTACLE, OUTLINE):
+            continue
+        objects = found.shapes.get(cls.name, [])
+        convert = _ring if cls.is_area else _xy
+        values = [convert(world(geometry)) for _, geometry in objects]
+        if cls.single:
+            if values:
+                _put(data, cls.field, values[0])
+                origins[cls.field] = objects[0][0]
+            continue
+        _put(data, cls.field, values)
+        origins[cls.field] = f"objects of class {cls.name!r}"
+        origins.update((f"{cls.field}[{i}]", where) for i, (where, _) in enumerate(objects))
     return data, origins
+
+
+def _put(data: dict[str, Any], field_name: str, value: Any) -> None:
+    """Set a field of the level structure; ``"zones.KIND"`` is ``data["zones"]["KIND"]``."""
+    *parents, key = field_name.split(".")
+    for parent in parents:
+        data = data.setdefault(parent, {})
+    data[key] = value
 
 
 # --------------------------------------------------------------------------- reading
@@ -249,7 +245,7 @@ def _collect(
         if isinstance(layer, tl.LayerGroup):
             _collect(layer.layers or [], f"{name}/", lx, ly, found, src)
         elif isinstance(layer, tl.TileLayer):
-            is_walls = WALLS in (layer.name.strip().lower(), _class_of(layer))
+            is_walls = WALLS.name in (layer.name.strip().lower(), _class_of(layer))
             cols, rows = _nonzero_tiles(layer, name, src, required=is_walls)
             if is_walls:
                 found.walls.append((name, cols, rows, lx, ly))
@@ -295,14 +291,12 @@ def _collect_object(
     if not cls:
         return  # decoration
     where = _describe_object(obj, layer, cls)
-    areas = (*_SHAPE_CLASSES, *zone_kinds())
-    points = (*_POINT_CLASSES, *_SINGLE_POINT_CLASSES)
-    if cls not in areas and cls not in points:
-        known = ", ".join((*points, *areas))
+    if cls not in found.classes:
+        known = ", ".join(found.classes)
         _warn(src, where, f"unknown class {obj.class_!r}, treated as decoration (known "
                           f"classes: {known})")
         return
-    geometry = _object_geometry(obj, ox, oy, where, src, want_area=cls in areas)
+    geometry = _object_geometry(obj, ox, oy, where, src, want_area=found.classes[cls].is_area)
     found.shapes.setdefault(cls, []).append((where, geometry))
 
 
@@ -360,18 +354,19 @@ def _object_geometry(
 
 
 def _warn_of_missing_parts(found: _Collected, tmap: pytiled_parser.TiledMap, src: str) -> None:
-    """One warning line for a map without guards, one for a map that is an empty box."""
-    if not found.shapes.get("guard"):
-        _warn(src, "map", "no object of class 'guard': the guards start at random nodes "
-                          "(as with world.spawns = \"random\")")
+    """One warning line for each class with a ``when_missing`` reason that the map has no
+    object of (guards), and one for a map that is an empty box."""
+    for cls in found.classes.values():
+        if cls.when_missing and not found.shapes.get(cls.name):
+            _warn(src, "map", f"no object of class {cls.name!r}: {cls.when_missing}")
     walls = any(c.size for _, c, _, _, _ in found.walls)
-    if not walls and not found.shapes.get("obstacle") and not found.shapes.get("outline"):
+    if not walls and not found.shapes.get(OBSTACLE.name) and not found.shapes.get(OUTLINE.name):
         size = ("infinite" if tmap.infinite
                 else f"{int(tmap.map_size.width)}x{int(tmap.map_size.height)} tiles")
         _warn(src, "map", f"no walls, obstacles or outline: the level is an empty box "
                           f"({size}); blocked cells are the tiles of a tile layer named or of "
-                          "class 'walls' and objects of class 'obstacle', an object of class "
-                          "'outline' is the boundary")
+                          f"class {WALLS.name!r} and objects of class {OBSTACLE.name!r}, an "
+                          f"object of class {OUTLINE.name!r} is the boundary")
 
 
 def _wall_tiles(found: _Collected, tile: float) -> tuple[np.ndarray, np.ndarray]:
@@ -388,7 +383,7 @@ def _content_bounds(
     if outline_objects:
         minx, miny, maxx, maxy = outline_objects[0][1].bounds
     else:
-        boxes = [g.bounds for _, g in found.shapes.get("obstacle", [])]
+        boxes = [g.bounds for _, g in found.shapes.get(OBSTACLE.name, [])]
         for _, c, r, ox, oy in found.walls:
             if c.size:
                 boxes.append((c.min() * tile + ox, r.min() * tile + oy,

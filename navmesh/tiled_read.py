@@ -9,8 +9,9 @@ does. The map's bytes come from the caller (read once, bounded); the decoded doc
 checked and its object templates merged in by :func:`navmesh.tiled_guard.guard_map`, then
 its layers are parsed by pytiled-parser's own layer readers (every data encoding and
 compression, chunks, groups), which then open no file. A map that is not orthogonal is
-refused before anything else is checked, so an isometric, staggered or hexagonal map gets
-that one line whatever else it holds.
+refused before anything else is checked (once its text is decoded: a JSON map must be
+UTF-8, as Tiled writes it), so an isometric, staggered or hexagonal map gets that one line
+whatever else it holds.
 """
 
 from __future__ import annotations
@@ -71,7 +72,7 @@ def _read_tmx(path: Path, raw: bytes, source: str) -> TiledMap:
 
 
 def _read_json(path: Path, raw: bytes, source: str) -> TiledMap:
-    data = json.loads(raw.decode("utf-8-sig"))
+    data = json.loads(_utf8(raw, source))
     if not isinstance(data, dict):
         raise ValueError("the JSON is not an object")
     _check_orientation(data.get("orientation", ORTHOGONAL), source)
@@ -90,6 +91,20 @@ def _read_json(path: Path, raw: bytes, source: str) -> TiledMap:
     elif properties:
         tmap.properties = parse_json_properties(properties)
     return tmap
+
+
+def _utf8(raw: bytes, source: str) -> str:
+    """A JSON map's text. Tiled writes UTF-8 (a byte order mark allowed); anything else is
+    refused in one line — UTF-16 above all, whose NUL bytes UTF-8 would otherwise accept (a
+    UTF-16 TMX with a byte order mark comes here too: it does not start with ``<``)."""
+    problem = "not UTF-8 text (invalid byte at offset {}); Tiled writes maps in UTF-8"
+    try:
+        text = raw.decode("utf-8-sig")
+    except UnicodeDecodeError as exc:
+        _refuse(source, problem.format(exc.start))
+    if b"\0" in raw:  # never in JSON text; every other byte of UTF-16
+        _refuse(source, problem.format(raw.index(b"\0")))
+    return text
 
 
 def _tiled_map(path: Path, header: Any, *, infinite: bool, layers: list, size: tuple[int, int],

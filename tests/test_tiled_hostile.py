@@ -310,7 +310,7 @@ def test_a_tmj_object_at_nan_and_a_polygon_point_at_nan(tmp_path, capsys):
 @pytest.mark.parametrize("key,message", [
     ('"x": 48', "object 3 (guard): position must be finite numbers, got inf"),
     ('"rotation": 0', "object 3 (guard): size and rotation must be finite numbers, got inf"),
-    ('"tilewidth": 32', "map: tiles wider than 2147483648 pixels are not supported"),
+    ('"tilewidth": 32', "pixels wide are not supported; tiles are at most 65536 pixels wide"),
     ('"value": 7', "map property cell_size: must be a finite number > 0"),
 ])
 def test_integers_beyond_a_float_are_one_line(tmp_path, capsys, key, message):
@@ -324,6 +324,40 @@ def test_integers_beyond_a_float_are_one_line(tmp_path, capsys, key, message):
     assert key in text
     path.write_text(text.replace(key, huge))
     refused(path, message, capsys)
+
+
+@pytest.mark.parametrize("kind", ["tmx", "tmj"])
+@pytest.mark.parametrize("pixels", [10**30, 2**31, 2**16 + 1])
+def test_a_tile_too_wide_is_refused_naming_its_size(tmp_path, capsys, kind, pixels):
+    """Wider tiles made the maze's objects zero-area specks: the line named a zone, not the
+    tile size; 65536-pixel tiles load (objects scaled with them: the same level)."""
+    def scaled(tile: int) -> Path:
+        if kind == "tmj":
+            return tmj(tmp_path, [{"id": 3, "type": "guard", "x": 1.5 * tile, "y": 1.5 * tile,
+                                   "point": True}], tilewidth=tile, tileheight=tile)
+        path = tmx(tmp_path, objects=f'<object id="3" type="guard" x="{1.5 * tile}" '
+                                     f'y="{1.5 * tile}"><point/></object>')
+        path.write_text(path.read_text().replace('tilewidth="32" tileheight="32"',
+                                                 f'tilewidth="{tile}" tileheight="{tile}"'))
+        return path
+
+    refused(scaled(pixels), f"map: tiles {pixels} pixels wide are not supported; tiles are at "
+                            "most 65536 pixels wide", capsys)
+    wide, usual = load_level(scaled(2**16)), load_level(scaled(32))
+    assert (wide.occupancy == usual.occupancy).all() and wide.guards == usual.guards == (
+        (1.5, 1.5),)
+
+
+@pytest.mark.parametrize("name,encoding", [("map.tmx", "utf-16"), ("map.tmj", "utf-16"),
+                                           ("map.tmj", "utf-16-be")])
+def test_a_map_that_is_not_utf8_is_one_clear_line(tmp_path, capsys, name, encoding):
+    """Tiled writes UTF-8: a UTF-16 map (with a byte order mark, or JSON without one) is
+    refused as such, not with a UnicodeDecodeError or a JSON syntax error."""
+    path = tmx(tmp_path) if name == "map.tmx" else tmj(tmp_path)
+    text = path.read_text(encoding="utf-8").replace('encoding="UTF-8"', 'encoding="UTF-16"')
+    path.write_bytes(text.encode(encoding))
+    refused(path, f"{name}: map: not UTF-8 text (invalid byte at offset 0); Tiled writes maps "
+                  "in UTF-8", capsys)
 
 
 @pytest.mark.parametrize("width", ["abc", "1.5", 1.5, True, "²"])
