@@ -133,7 +133,9 @@ def _registration(name: str, factory: Any, display: str | None, short: str | Non
                   params: type[Params] | str | None) -> Registration[Any]:
     """A registration with its names filled in; refuses a section that another
     registration fills with another parameter class (one section, one set of keys)."""
-    for other in [*GUARD_MODES._entries.values(), *PLAYER_POLICIES._entries.values()]:
+    held_now: list[Registration[Any]] = [*GUARD_MODES._entries.values(),
+                                         *PLAYER_POLICIES._entries.values()]  # loads nothing
+    for other in held_now:
         held = other.parameters() if other.params is not None else None
         if (other.name != name and other.section == section and held is not None
                 and params is not None and other.params != params and held is not _resolve(params)):

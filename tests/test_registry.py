@@ -6,6 +6,7 @@ These are the two rows of docs/architecture.md's "to add X, touch Y" table done 
 from __future__ import annotations
 
 import ast
+import inspect
 import json
 import os
 import sqlite3
@@ -378,29 +379,14 @@ def test_the_replay_draws_what_the_stimulus_declares_a_marker(bell: Path) -> Non
 # ------------------------------------------ an installed guard mode: found by every process
 
 
-PATROL_PACKAGE = '''
-from dataclasses import dataclass
-
-from ai import register_guard_mode
-from ai.baselines import RandomWalkGuards
-from ai.bounds import POSITIVE
-from ai.params import Params
-
-
-@dataclass(frozen=True)
-class PatrolParams(Params):
-    speed: float = 1.0
-    bounds = {"speed": POSITIVE}
-
-
-class PatrolGuards(RandomWalkGuards):
-    def __init__(self, params=None):
-        super().__init__(params)
-        self.settings = PatrolParams.from_mapping(params)
-
-
-register_guard_mode("patrol", PatrolGuards, display="Patrol", short="P", params=PatrolParams)
-'''
+#: an installed package holding the Patrol mode above, registered on import
+PATROL_PACKAGE = "\n".join([
+    "from __future__ import annotations", "from dataclasses import dataclass",
+    "from ai import register_guard_mode", "from ai.baselines import RandomWalkGuards",
+    "from ai.bounds import POSITIVE", "from ai.params import Params",
+    inspect.getsource(PatrolParams), inspect.getsource(PatrolGuards),
+    'register_guard_mode("patrol", PatrolGuards, display="Patrol", short="P", '
+    'params=PatrolParams)'])
 
 
 def _install(site: Path, package: str, source: str, entry: str) -> Path:
