@@ -389,15 +389,16 @@ PATROL_PACKAGE = "\n".join([
     'params=PatrolParams)'])
 
 
-def _install(site: Path, package: str, source: str, entry: str) -> Path:
+def _install(site: Path, package: str, source: str, entry: str,
+             group: str = "stealthfield.guard_modes") -> Path:
     """An installed-looking distribution in ``site``: ``package.py`` and its dist-info
-    declaring ``entry`` under ``[stealthfield.guard_modes]``."""
+    declaring ``entry`` under ``[group]``."""
     (site / f"{package}.py").write_text(source, encoding="utf-8")
     info = site / f"{package}-0.1.dist-info"
     info.mkdir()
     (info / "METADATA").write_text(f"Metadata-Version: 2.1\nName: {package}\nVersion: 0.1\n",
                                    encoding="utf-8")
-    (info / "entry_points.txt").write_text(f"[stealthfield.guard_modes]\n{entry}\n",
+    (info / "entry_points.txt").write_text(f"[{group}]\n{entry}\n",
                                            encoding="utf-8")
     return site
 
@@ -449,3 +450,16 @@ def test_a_broken_installed_guard_mode_is_one_line_naming_its_entry_point(
     assert result.stderr == ("stealth: error: patrol: cannot load entry point 'brokenpkg' "
                              "(stealthfield.guard_modes): RuntimeError: no patrol today\n")
     assert _stealth(site, "--help").returncode == 0  # the top-level help reads no registry
+
+
+def test_an_installed_player_policy_may_be_registered_by_a_function(tmp_path: Path) -> None:
+    source = ("from ai import register_player_policy\n\n\ndef register():\n"
+              "    register_player_policy('still', 'ai.players:EvadePlayer', display='Still')\n")
+    site = _install(tmp_path, "stillpkg", source, "still = stillpkg:register",
+                    "stealthfield.player_policies")
+    listed = _stealth(site, "sim", "--help")
+    assert listed.returncode == 0 and "maxmin, safetygraph, evade, still" in " ".join(
+        listed.stdout.split())
+    sim = _stealth(site, "sim", "maze", "--player", "still", "--set", "world.duration=2",
+                   "--json")
+    assert sim.returncode == 0 and json.loads(sim.stdout)["player"] == "still", sim.stderr
