@@ -7,7 +7,8 @@ the controller, its parameter dataclass and the config section those parameters 
 figures, robustness), and its place (the number keys of ``stealth play``). The world, the
 CLI, the sweep and the reports never import a concrete controller class or write a mode's
 name again, so a new mode is one :func:`register_guard_mode` call in the module that
-defines it (or in a test):
+defines it (or in a test). Installed packages register theirs through the entry points
+of :mod:`ai.installed`, imported at the registry's first read, so every process sees them:
 
 >>> from ai.baselines import RandomWalkGuards
 >>> register_guard_mode("random2", RandomWalkGuards, display="RandomWalk (copy)", short="R2")
@@ -18,7 +19,7 @@ defines it (or in a test):
 
 from __future__ import annotations
 
-from collections.abc import Callable, Iterator, Mapping
+from collections.abc import Callable, Iterator, Mapping, MutableMapping
 from dataclasses import dataclass
 from functools import cached_property
 from importlib import import_module
@@ -76,6 +77,41 @@ class Registration(Generic[T]):
         return _resolve(self.params) if self.params is not None else None
 
 
+class Registry(MutableMapping[str, Registration[T]]):
+    """Registrations by command-line name, in registration order. Its first read imports
+    the installed plugins (:func:`ai.installed.load_installed`: the
+    ``stealthfield.guard_modes`` and ``stealthfield.player_policies`` entry points), so
+    the CLI, the config, a sweep's workers and play all see an installed mode; writing
+    (registering) imports nothing."""
+
+    def __init__(self) -> None:
+        self._entries: dict[str, Registration[T]] = {}
+
+    def __getitem__(self, name: str) -> Registration[T]:
+        _load_installed()
+        return self._entries[name]
+
+    def __iter__(self) -> Iterator[str]:
+        _load_installed()
+        return iter(list(self._entries))
+
+    def __len__(self) -> int:
+        _load_installed()
+        return len(self._entries)
+
+    def __setitem__(self, name: str, registration: Registration[T]) -> None:
+        self._entries[name] = registration
+
+    def __delitem__(self, name: str) -> None:
+        del self._entries[name]
+
+
+def _load_installed() -> None:
+    from .installed import load_installed
+
+    load_installed()
+
+
 def registrations() -> list[Registration[Any]]:
     """Every registration: the guard modes', then the player policies'."""
     return [*GUARD_MODES.values(), *PLAYER_POLICIES.values()]
@@ -87,9 +123,9 @@ DEFAULT_GUARD_MODE = "pf"
 DEFAULT_PLAYER_POLICY = "maxmin"
 
 #: Registered guard modes by command-line name (SPEC §9 order: the order of play's keys).
-GUARD_MODES: dict[str, Registration[GuardAI]] = {}
+GUARD_MODES: Registry[GuardAI] = Registry()
 #: Registered player policies by command-line name.
-PLAYER_POLICIES: dict[str, Registration[PlayerPolicy]] = {}
+PLAYER_POLICIES: Registry[PlayerPolicy] = Registry()
 
 
 def _registration(name: str, factory: Any, display: str | None, short: str | None,
@@ -97,7 +133,9 @@ def _registration(name: str, factory: Any, display: str | None, short: str | Non
                   params: type[Params] | str | None) -> Registration[Any]:
     """A registration with its names filled in; refuses a section that another
     registration fills with another parameter class (one section, one set of keys)."""
-    for other in registrations():
+    held_now: list[Registration[Any]] = [*GUARD_MODES._entries.values(),
+                                         *PLAYER_POLICIES._entries.values()]  # loads nothing
+    for other in held_now:
         held = other.parameters() if other.params is not None else None
         if (other.name != name and other.section == section and held is not None
                 and params is not None and other.params != params and held is not _resolve(params)):
@@ -130,12 +168,12 @@ def register_player_policy(name: str, factory: Callable[..., PlayerPolicy] | str
 
 def unregister_guard_mode(name: str) -> None:
     """Remove a guard mode registered by :func:`register_guard_mode` (tests, notebooks)."""
-    GUARD_MODES.pop(name, None)
+    GUARD_MODES._entries.pop(name, None)
 
 
 def unregister_player_policy(name: str) -> None:
     """Remove a player policy registered by :func:`register_player_policy`."""
-    PLAYER_POLICIES.pop(name, None)
+    PLAYER_POLICIES._entries.pop(name, None)
 
 
 class Names(Mapping[str, str]):
@@ -203,7 +241,7 @@ register_player_policy("evade", "ai.players:EvadePlayer", display="Evade", short
 
 __all__ = [
     "DEFAULT_GUARD_MODE", "DEFAULT_PLAYER_POLICY", "Event", "GuardAI", "Names", "PlayerPolicy",
-    "Registration", "WorldView", "GUARD_MODES", "PLAYER_POLICIES", "guard_mode",
+    "Registration", "Registry", "WorldView", "GUARD_MODES", "PLAYER_POLICIES", "guard_mode",
     "make_guard_ai", "make_player_policy", "player_policy", "register_guard_mode",
     "register_player_policy", "registrations", "unregister_guard_mode",
     "unregister_player_policy",

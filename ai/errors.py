@@ -8,11 +8,16 @@ from __future__ import annotations
 
 from navmesh.errors import StealthError
 
-__all__ = ["StealthError", "StimulusError", "UnknownNameError", "WorkBudgetError"]
+__all__ = ["PluginError", "StealthError", "StimulusError", "UnknownNameError", "WorkBudgetError"]
 
 
 class UnknownNameError(StealthError, ValueError):
     """A guard mode or player policy name that is not registered; the message lists the names."""
+
+
+class PluginError(StealthError, ValueError):
+    """An installed guard-mode or player-policy entry point that cannot be loaded; the
+    message is one line naming it (:mod:`ai.installed`)."""
 
 
 class StimulusError(StealthError, ValueError):

@@ -12,6 +12,7 @@ from typing import Any
 from navmesh.level import register_zone_kind
 
 from .errors import StimulusError
+from .installed import load_entry_point
 from .stimulus import Measure, Stimulus, register_stimulus
 
 #: importlib.metadata entry-point group under which installed packages register stimuli
@@ -56,10 +57,7 @@ def _entry_point(name: str) -> Any:
             f"{name}: expected FILE.py:NAME or the name of an installed "
             f"{ENTRY_POINT_GROUP} entry point{hint}"
         )
-    try:
-        return found[0].load()
-    except (Exception, SystemExit) as error:
-        raise StimulusError(f"{name}: cannot load entry point: {error}") from None
+    return load_entry_point(found[0], StimulusError)
 
 
 def load_stimulus(spec: str) -> StimulusFactory:

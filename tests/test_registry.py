@@ -6,7 +6,12 @@ These are the two rows of docs/architecture.md's "to add X, touch Y" table done 
 from __future__ import annotations
 
 import ast
+import inspect
 import json
+import os
+import sqlite3
+import subprocess
+import sys
 from collections.abc import Iterator, Mapping
 from dataclasses import dataclass
 from pathlib import Path
@@ -369,3 +374,92 @@ def test_the_replay_draws_what_the_stimulus_declares_a_marker(bell: Path) -> Non
     # the built-ins answer the same question: footsteps and rain are not drawn, throws are
     assert [STIMULUS_TYPES[n].marker for n in ("footstep", "rain", "thrown_decoy", "decoy",
                                                "corpse")] == [False, False, True, True, True]
+
+
+# ------------------------------------------ an installed guard mode: found by every process
+
+
+#: an installed package holding the Patrol mode above, registered on import
+PATROL_PACKAGE = "\n".join([
+    "from __future__ import annotations", "from dataclasses import dataclass",
+    "from ai import register_guard_mode", "from ai.baselines import RandomWalkGuards",
+    "from ai.bounds import POSITIVE", "from ai.params import Params",
+    inspect.getsource(PatrolParams), inspect.getsource(PatrolGuards),
+    'register_guard_mode("patrol", PatrolGuards, display="Patrol", short="P", '
+    'params=PatrolParams)'])
+
+
+def _install(site: Path, package: str, source: str, entry: str,
+             group: str = "stealthfield.guard_modes") -> Path:
+    """An installed-looking distribution in ``site``: ``package.py`` and its dist-info
+    declaring ``entry`` under ``[group]``."""
+    (site / f"{package}.py").write_text(source, encoding="utf-8")
+    info = site / f"{package}-0.1.dist-info"
+    info.mkdir()
+    (info / "METADATA").write_text(f"Metadata-Version: 2.1\nName: {package}\nVersion: 0.1\n",
+                                   encoding="utf-8")
+    (info / "entry_points.txt").write_text(f"[{group}]\n{entry}\n",
+                                           encoding="utf-8")
+    return site
+
+
+def _stealth(site: Path, *args: str, code: str = "") -> subprocess.CompletedProcess[str]:
+    """``stealth ARGS`` in a fresh interpreter whose path holds ``site`` (nothing imports
+    the plugin by hand); ``code`` runs first (e.g. choosing the spawn start method)."""
+    root = Path(__file__).resolve().parents[1]
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join([str(root), str(site)])}
+    script = f"import sys\n{code}\nfrom headless.cli import main\nsys.exit(main(sys.argv[1:]))"
+    return subprocess.run([sys.executable, "-c", script, *args], capture_output=True,
+                          text=True, timeout=300, env=env, cwd=site)
+
+
+def test_an_installed_guard_mode_is_found_by_the_cli_its_config_and_a_sweeps_workers(
+        tmp_path: Path) -> None:
+    site = _install(tmp_path, "patrolpkg", PATROL_PACKAGE, "patrol = patrolpkg")
+    code = ("import sys\nfrom importlib.metadata import entry_points\n"
+            "print([ep.value for ep in entry_points(group='stealthfield.guard_modes')])")
+    found = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                           timeout=60, env={**os.environ, "PYTHONPATH": str(site)})
+    assert found.stdout.strip() == "['patrolpkg']", found.stderr  # discovered as installed
+    sim = _stealth(site, "sim", "maze", "--guards", "patrol", "--set", "patrol.speed=2",
+                   "--set", "world.duration=5", "--json")
+    assert sim.returncode == 0, sim.stderr
+    row = json.loads(sim.stdout)
+    assert row["guards"] == "patrol" and row["config"]["patrol.speed"] == 2.0
+    # a preset names it; the trials run in worker processes started fresh (spawn), which
+    # find it themselves, with the same config as the single trial above
+    preset = tmp_path / "patrol.toml"
+    preset.write_text('levels = ["maze"]\nabstractions = ["grid"]\nguards = ["patrol"]\n'
+                      'players = ["maxmin"]\nscenarios = ["capture"]\nseeds = 2\n\n[set]\n'
+                      '"world.duration" = 5.0\n"patrol.speed" = 2.0\n', encoding="utf-8")
+    run = _stealth(site, "run", "--preset", str(preset), "--out", str(tmp_path / "out"),
+                   "--workers", "2",
+                   code="import multiprocessing; multiprocessing.set_start_method('spawn')")
+    assert run.returncode == 0, run.stderr
+    with sqlite3.connect(tmp_path / "out" / "results.sqlite") as db:
+        stored = db.execute("SELECT guards, config_hash, error FROM trials").fetchall()
+    assert stored == [("patrol", row["config_hash"], None)] * 2
+
+
+def test_a_broken_installed_guard_mode_is_one_line_naming_its_entry_point(
+        tmp_path: Path) -> None:
+    site = _install(tmp_path, "brokenpkg", 'raise RuntimeError("no patrol today")\n',
+                    "patrol = brokenpkg")
+    result = _stealth(site, "sim", "maze", "--guards", "patrol")
+    assert result.returncode == 2 and result.stdout == ""
+    assert result.stderr == ("stealth: error: patrol: cannot load entry point 'brokenpkg' "
+                             "(stealthfield.guard_modes): RuntimeError: no patrol today\n")
+    assert _stealth(site, "--help").returncode == 0  # the top-level help reads no registry
+
+
+def test_an_installed_player_policy_may_be_registered_by_a_function(tmp_path: Path) -> None:
+    source = ("from ai import register_player_policy\n\n\ndef register():\n"
+              "    register_player_policy('still', 'ai.players:EvadePlayer', display='Still')\n")
+    site = _install(tmp_path, "stillpkg", source, "still = stillpkg:register",
+                    "stealthfield.player_policies")
+    listed = _stealth(site, "sim", "--help")
+    assert listed.returncode == 0 and "maxmin, safetygraph, evade, still" in " ".join(
+        listed.stdout.split())
+    sim = _stealth(site, "sim", "maze", "--player", "still", "--set", "world.duration=2",
+                   "--json")
+    assert sim.returncode == 0 and json.loads(sim.stdout)["player"] == "still", sim.stderr

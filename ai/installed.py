@@ -1,0 +1,64 @@
+"""Installed plugins: packages that register guard modes and player policies through
+``importlib.metadata`` entry points, imported once per process.
+
+A package declares, in its ``pyproject.toml``::
+
+    [project.entry-points."stealthfield.guard_modes"]
+    patrol = "mypkg.patrol"            # a module whose import registers the mode
+    # or "mypkg.patrol:register"       # a function of no arguments that registers it
+
+The registry (:data:`ai.GUARD_MODES`, :data:`ai.PLAYER_POLICIES`) calls
+:func:`load_installed` before its first read, so every process — ``stealth``, a sweep's
+worker, a notebook — sees the installed modes without importing them by hand. The stimuli's
+entry points (``stealthfield.stimuli``, :mod:`ai.plugins`) share :func:`load_entry_point`.
+"""
+
+from __future__ import annotations
+
+from types import ModuleType
+from typing import TYPE_CHECKING, Any
+
+from .errors import PluginError, StealthError
+
+if TYPE_CHECKING:
+    from importlib.metadata import EntryPoint
+
+#: entry-point groups whose entries register guard modes and player policies when loaded
+GROUPS = ("stealthfield.guard_modes", "stealthfield.player_policies")
+
+_loaded = False
+
+
+def load_entry_point(ep: EntryPoint, error: type[StealthError] = PluginError) -> Any:
+    """The object ``ep`` names; ``error`` (one line naming the entry point) if importing it
+    fails, whatever the package raises (``sys.exit()`` too)."""
+    try:
+        return ep.load()
+    except (Exception, SystemExit) as failure:
+        raise error(f"{ep.name}: cannot load entry point {ep.value!r} ({ep.group}): "
+                    f"{type(failure).__name__}: {failure}") from None
+
+
+def load_installed() -> None:
+    """Import every installed ``stealthfield.guard_modes`` / ``stealthfield.player_policies``
+    entry point, once per process (later calls return at once, also after a failure, which
+    raises :class:`~ai.errors.PluginError` the first time). No package installed: nothing."""
+    global _loaded
+    if _loaded:
+        return
+    _loaded = True  # first: the plugins' own registrations read the registry
+    from importlib.metadata import entry_points
+
+    for group in GROUPS:
+        for ep in entry_points(group=group):
+            obj = load_entry_point(ep)
+            if isinstance(obj, ModuleType):
+                continue  # importing it registered its modes
+            if not callable(obj) or isinstance(obj, type):
+                raise PluginError(f"{ep.name}: entry point {ep.value!r} ({group}) names "
+                                  "neither a module nor a function that registers")
+            try:
+                obj()
+            except (Exception, SystemExit) as failure:
+                raise PluginError(f"{ep.name}: entry point {ep.value!r} ({group}) failed: "
+                                  f"{type(failure).__name__}: {failure}") from None
