@@ -15,6 +15,9 @@ entry points (``stealthfield.stimuli``, :mod:`ai.plugins`) share :func:`load_ent
 
 from __future__ import annotations
 
+import sys
+from collections.abc import Iterator
+from contextlib import contextmanager, redirect_stdout
 from types import ModuleType
 from typing import TYPE_CHECKING, Any
 
@@ -29,14 +32,30 @@ GROUPS = ("stealthfield.guard_modes", "stealthfield.player_policies")
 _loaded = False
 
 
+@contextmanager
+def plugin_code(what: str, error: type[StealthError] = PluginError) -> Iterator[None]:
+    """Run a plugin's code (its import, its registering function): what it prints goes to
+    stderr, so ``--json`` keeps stdout one JSON document; whatever it raises — ``sys.exit()``
+    and other ``BaseException`` subclasses too — is ``error``, one line starting with
+    ``what``. Only ``KeyboardInterrupt`` passes, as a Ctrl-C during the import is one."""
+    try:
+        with redirect_stdout(sys.stderr):
+            yield
+    except KeyboardInterrupt:
+        raise
+    except StealthError as failure:  # a registration refused: its own line
+        raise error(f"{what}: {failure}") from None
+    except SystemExit as exit_:  # the command must not end silently
+        raise error(f"{what}: it called sys.exit({exit_.code!r})") from None
+    except BaseException as failure:
+        raise error(f"{what}: {type(failure).__name__}: {failure}") from None
+
+
 def load_entry_point(ep: EntryPoint, error: type[StealthError] = PluginError) -> Any:
     """The object ``ep`` names; ``error`` (one line naming the entry point) if importing it
-    fails, whatever the package raises (``sys.exit()`` too)."""
-    try:
+    fails, whatever the package raises (:func:`plugin_code`)."""
+    with plugin_code(f"{ep.name}: cannot load entry point {ep.value!r} ({ep.group})", error):
         return ep.load()
-    except (Exception, SystemExit) as failure:
-        raise error(f"{ep.name}: cannot load entry point {ep.value!r} ({ep.group}): "
-                    f"{type(failure).__name__}: {failure}") from None
 
 
 def load_installed() -> None:
@@ -57,8 +76,5 @@ def load_installed() -> None:
             if not callable(obj) or isinstance(obj, type):
                 raise PluginError(f"{ep.name}: entry point {ep.value!r} ({group}) names "
                                   "neither a module nor a function that registers")
-            try:
+            with plugin_code(f"{ep.name}: entry point {ep.value!r} ({group}) failed"):
                 obj()
-            except (Exception, SystemExit) as failure:
-                raise PluginError(f"{ep.name}: entry point {ep.value!r} ({group}) failed: "
-                                  f"{type(failure).__name__}: {failure}") from None
