@@ -25,7 +25,7 @@ from functools import cached_property
 from importlib import import_module
 from typing import TYPE_CHECKING, Any, Generic, TypeVar
 
-from .errors import UnknownNameError
+from .errors import PluginError, UnknownNameError
 from .view import Event, GuardAI, PlayerPolicy, WorldView
 
 if TYPE_CHECKING:
@@ -34,11 +34,16 @@ if TYPE_CHECKING:
 T = TypeVar("T", GuardAI, PlayerPolicy)
 
 
-def _resolve(ref: Any) -> Any:
-    """``ref`` itself, or the object a lazy ``"module:attr"`` reference names."""
+def _resolve(ref: Any, name: str = "") -> Any:
+    """``ref`` itself, or the object a lazy ``"module:attr"`` reference names; a reference
+    that names nothing is a :class:`~ai.errors.PluginError` naming registration ``name``."""
     if isinstance(ref, str):
         module, _, attr = ref.partition(":")
-        return getattr(import_module(module), attr)
+        try:
+            return getattr(import_module(module), attr)
+        except (ImportError, AttributeError) as error:
+            raise PluginError(f"{name}: cannot import {ref!r} "
+                              f"({type(error).__name__}: {error})") from None
     return ref
 
 
@@ -64,9 +69,14 @@ class Registration(Generic[T]):
     params: type[Params] | str | None = None
 
     def build(self, params: Mapping[str, Any] | None = None) -> T:
-        """A fresh controller with ``params``."""
-        factory: Callable[[Mapping[str, Any] | None], T] = _resolve(self.factory)
-        return factory(params)
+        """A fresh controller with ``params``; :class:`~ai.errors.PluginError` if the factory
+        returns no guard team controller or player policy."""
+        factory: Callable[[Mapping[str, Any] | None], T] = _resolve(self.factory, self.name)
+        made = factory(params)
+        if not isinstance(made, (GuardAI, PlayerPolicy)):
+            raise PluginError(f"{self.name}: its factory returned {type(made).__name__}, not "
+                              "an ai.GuardAI or ai.PlayerPolicy")
+        return made
 
     def parameters(self) -> type[Params] | None:
         """The parameter dataclass (imported on first use), or None."""
@@ -74,7 +84,7 @@ class Registration(Generic[T]):
 
     @cached_property
     def _parameters(self) -> type[Params] | None:
-        return _resolve(self.params) if self.params is not None else None
+        return _resolve(self.params, self.name) if self.params is not None else None
 
 
 class Registry(MutableMapping[str, Registration[T]]):
@@ -157,7 +167,7 @@ def _registration(name: str, factory: Any, display: str | None, short: str | Non
     for other in held_now:
         held = other.parameters() if other.params is not None else None
         if (other.name != name and other.section == section and held is not None
-                and params is not None and other.params != params and held is not _resolve(params)):
+                and params is not None and other.params != params and held is not _resolve(params, name)):
             raise ValueError(f"{name}: config section [{section}] already holds the parameters "
                              f"of {other.name!r} ({held.__name__})")
     display = display or name.title()
