@@ -167,7 +167,8 @@ def _registration(name: str, factory: Any, display: str | None, short: str | Non
     for other in held_now:
         held = other.parameters() if other.params is not None else None
         if (other.name != name and other.section == section and held is not None
-                and params is not None and other.params != params and held is not _resolve(params, name)):
+                and params is not None and other.params != params
+                and held is not _resolve(params, name)):
             raise ValueError(f"{name}: config section [{section}] already holds the parameters "
                              f"of {other.name!r} ({held.__name__})")
     display = display or name.title()

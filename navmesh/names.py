@@ -8,8 +8,10 @@ first part of ``--set SECTION.KEY=V`` and a TOML table) or a Tiled class. A **la
 display or short name) is one line of printable text of at most :data:`MAX_LABEL`
 characters, because tables and figures print it in a cell.
 
->>> name_problem("patrol") is None, name_problem("a b"), label_problem("Patrol (slow)") is None
-(True, "must be a word (letters, digits, '_' or '-', starting with a letter or '_'), got 'a b'", True)
+>>> name_problem("patrol") is None, label_problem("Patrol (slow)") is None
+(True, True)
+>>> name_problem("a b")
+"must be a word (letters, digits, '_' or '-', starting with a letter or '_'), got 'a b'"
 """
 
 from __future__ import annotations

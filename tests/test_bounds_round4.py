@@ -47,10 +47,13 @@ def test_a_mode_or_policy_name_that_is_no_word_is_refused(name: object) -> None:
 
 
 @pytest.mark.parametrize(("option", "value", "message"), [
-    ("display", "a\nb", "display must be one line"), ("display", "", "display must be a non-empty"),
+    ("display", "a\nb", "display must be one line"),
+    ("display", "", "display must be a non-empty"),
     ("short", "x" * 10**6, "short must be at most 64"), ("abbrev", 5, "abbrev must be a string"),
-    ("section", "a.b", "section must be a word"), ("params", {"speed": 1}, "params must be a dataclass"),
-    ("params", SpeedParams(), "params must be a dataclass"), ("factory", 42, "factory must be callable"),
+    ("section", "a.b", "section must be a word"),
+    ("params", {"speed": 1}, "params must be a dataclass"),
+    ("params", SpeedParams(), "params must be a dataclass"),
+    ("factory", 42, "factory must be callable"),
 ])
 def test_a_bad_declaration_is_refused_naming_it(option: str, value: object, message: str) -> None:
     kwargs = {"factory": RandomWalkGuards, option: value}
@@ -139,8 +142,8 @@ def test_a_zone_kind_named_like_a_tiled_class_or_no_word_is_refused(kind: str) -
 def test_installed_code_cannot_replace_pf_nor_break_json(tmp_path: Path) -> None:
     head = "import ai\nfrom ai.baselines import RandomWalkGuards\n"
     (tmp_path / "a").mkdir()
-    site = _install(tmp_path / "a", "hpkg", head + "ai.register_guard_mode('pf', RandomWalkGuards)\n",
-                    "m = hpkg")
+    site = _install(tmp_path / "a", "hpkg",
+                    head + "ai.register_guard_mode('pf', RandomWalkGuards)\n", "m = hpkg")
     done = _stealth(site, "sim", "maze", "--set", "world.duration=2", "--json")
     assert done.returncode == 2 and done.stdout == ""
     assert done.stderr.splitlines() == [
