@@ -189,3 +189,22 @@ def test_paired_refuses_no_pairs_and_a_store_without_the_metric(tmp_path: Path, 
     assert paired_main([str(control), str(control)]) == 2
     err = capsys.readouterr().err.splitlines()
     assert len(err) == 1 and "for backtracks (a store of another version" in err[0]
+
+
+@pytest.mark.parametrize("analysis", ["held-out", "robustness"])
+def test_an_analysis_refuses_a_directory_as_its_figure_before_writing_anything(
+        analysis: str, tmp_path: Path, capsys) -> None:
+    """held-out drew --figure DIR as DIR.png beside it; a refusal after --write had
+    already been rewritten would leave half the outputs."""
+    from headless.cli import main
+
+    doc = tmp_path / "doc.md"
+    doc.write_text("<!-- a -->\n<!-- b -->\n", encoding="utf-8")
+    folder = tmp_path / "figures"
+    folder.mkdir()
+    assert main(["analyse", analysis, str(tmp_path), "--figure", str(folder),
+                 "--write", str(doc)]) == 2
+    err = capsys.readouterr().err.splitlines()
+    assert err == [f"stealth: error: --figure/--write {folder}: is a directory; it names a file"]
+    assert doc.read_text(encoding="utf-8") == "<!-- a -->\n<!-- b -->\n"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["doc.md", "figures"]
