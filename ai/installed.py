@@ -61,7 +61,10 @@ def load_entry_point(ep: EntryPoint, error: type[StealthError] = PluginError) ->
 def load_installed() -> None:
     """Import every installed ``stealthfield.guard_modes`` / ``stealthfield.player_policies``
     entry point, once per process (later calls return at once, also after a failure, which
-    raises :class:`~ai.errors.PluginError` the first time). No package installed: nothing."""
+    raises :class:`~ai.errors.PluginError` the first time). No package installed: nothing.
+    An entry point that registers a name already held (by another package, or by this
+    process before the registry's first read) is a ``PluginError``: which one won would
+    depend on the order the packages are found in."""
     global _loaded
     if _loaded:
         return
@@ -70,11 +73,26 @@ def load_installed() -> None:
 
     for group in GROUPS:
         for ep in entry_points(group=group):
+            held = _held()
             obj = load_entry_point(ep)
-            if isinstance(obj, ModuleType):
-                continue  # importing it registered its modes
-            if not callable(obj) or isinstance(obj, type):
-                raise PluginError(f"{ep.name}: entry point {ep.value!r} ({group}) names "
-                                  "neither a module nor a function that registers")
-            with plugin_code(f"{ep.name}: entry point {ep.value!r} ({group}) failed"):
-                obj()
+            if not isinstance(obj, ModuleType):  # a module registered its modes on import
+                if not callable(obj) or isinstance(obj, type):
+                    raise PluginError(f"{ep.name}: entry point {ep.value!r} ({group}) names "
+                                      "neither a module nor a function that registers")
+                with plugin_code(f"{ep.name}: entry point {ep.value!r} ({group}) failed"):
+                    obj()
+            now = _held()
+            taken = [name for name, reg in held.items() if now.get(name) != reg]  # the same: fine
+            if taken:
+                kind, name = taken[0]
+                raise PluginError(f"{ep.name}: entry point {ep.value!r} ({group}) registers "
+                                  f"{kind} {name!r} again, which another package or this "
+                                  "process registered first; one of them must use another name")
+
+
+def _held() -> dict[tuple[str, str], object]:
+    """Every registration held now, by kind and name (no installed plugin is loaded)."""
+    from . import GUARD_MODES, PLAYER_POLICIES
+
+    return {**{("guard mode", k): v for k, v in GUARD_MODES._entries.items()},
+            **{("player policy", k): v for k, v in PLAYER_POLICIES._entries.items()}}

@@ -208,3 +208,14 @@ def test_an_analysis_refuses_a_directory_as_its_figure_before_writing_anything(
     assert err == [f"stealth: error: --figure/--write {folder}: is a directory; it names a file"]
     assert doc.read_text(encoding="utf-8") == "<!-- a -->\n<!-- b -->\n"
     assert sorted(p.name for p in tmp_path.iterdir()) == ["doc.md", "figures"]
+
+
+def test_two_installed_packages_cannot_register_one_name(tmp_path: Path) -> None:
+    """Which one won depended on the order the packages were found in, without a word."""
+    for package, guards in (("pkga", "RandomWalkGuards"), ("pkgb", "CheatGuards")):
+        _install(tmp_path, package, "import ai\nfrom ai.baselines import RandomWalkGuards, "
+                 f"CheatGuards\nai.register_guard_mode('patrol', {guards})\n",
+                 f"{package} = {package}")
+    done = _stealth(tmp_path, "sim", "maze", "--guards", "patrol")
+    assert done.returncode == 2 and len(done.stderr.splitlines()) == 1
+    assert "registers guard mode 'patrol' again, which another package" in done.stderr
