@@ -132,7 +132,7 @@ class Registry(MutableMapping[str, Registration[T]]):
 def _load_installed() -> None:
     from .installed import load_installed
 
-    load_installed()
+    load_installed({"guard mode": GUARD_MODES._entries, "player policy": PLAYER_POLICIES._entries})
 
 
 def registrations() -> list[Registration[Any]]:

@@ -16,7 +16,7 @@ entry points (``stealthfield.stimuli``, :mod:`ai.plugins`) share :func:`load_ent
 from __future__ import annotations
 
 import sys
-from collections.abc import Iterator
+from collections.abc import Iterator, Mapping
 from contextlib import contextmanager, redirect_stdout
 from types import ModuleType
 from typing import TYPE_CHECKING, Any
@@ -58,13 +58,15 @@ def load_entry_point(ep: EntryPoint, error: type[StealthError] = PluginError) ->
         return ep.load()
 
 
-def load_installed() -> None:
+def load_installed(tables: Mapping[str, Mapping[str, object]]) -> None:
     """Import every installed ``stealthfield.guard_modes`` / ``stealthfield.player_policies``
     entry point, once per process (later calls return at once, also after a failure, which
     raises :class:`~ai.errors.PluginError` the first time). No package installed: nothing.
     An entry point that registers a name already held (by another package, or by this
     process before the registry's first read) is a ``PluginError``: which one won would
-    depend on the order the packages are found in."""
+    depend on the order the packages are found in. ``tables`` are the registrations by
+    kind (``"guard mode"``: :data:`ai.GUARD_MODES`'s), read before and after each entry
+    point."""
     global _loaded
     if _loaded:
         return
@@ -73,7 +75,7 @@ def load_installed() -> None:
 
     for group in GROUPS:
         for ep in entry_points(group=group):
-            held = _held()
+            held = _held(tables)
             obj = load_entry_point(ep)
             if not isinstance(obj, ModuleType):  # a module registered its modes on import
                 if not callable(obj) or isinstance(obj, type):
@@ -81,7 +83,7 @@ def load_installed() -> None:
                                       "neither a module nor a function that registers")
                 with plugin_code(f"{ep.name}: entry point {ep.value!r} ({group}) failed"):
                     obj()
-            now = _held()
+            now = _held(tables)
             taken = [name for name, reg in held.items() if now.get(name) != reg]  # the same: fine
             if taken:
                 kind, name = taken[0]
@@ -90,9 +92,6 @@ def load_installed() -> None:
                                   "process registered first; one of them must use another name")
 
 
-def _held() -> dict[tuple[str, str], object]:
-    """Every registration held now, by kind and name (no installed plugin is loaded)."""
-    from . import GUARD_MODES, PLAYER_POLICIES
-
-    return {**{("guard mode", k): v for k, v in GUARD_MODES._entries.items()},
-            **{("player policy", k): v for k, v in PLAYER_POLICIES._entries.items()}}
+def _held(tables: Mapping[str, Mapping[str, object]]) -> dict[tuple[str, str], object]:
+    """Every registration held now, by kind and name."""
+    return {(kind, name): reg for kind, table in tables.items() for name, reg in table.items()}
