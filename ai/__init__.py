@@ -25,7 +25,7 @@ from functools import cached_property
 from importlib import import_module
 from typing import TYPE_CHECKING, Any, Generic, TypeVar
 
-from .errors import UnknownNameError
+from .errors import PluginError, UnknownNameError
 from .view import Event, GuardAI, PlayerPolicy, WorldView
 
 if TYPE_CHECKING:
@@ -34,11 +34,16 @@ if TYPE_CHECKING:
 T = TypeVar("T", GuardAI, PlayerPolicy)
 
 
-def _resolve(ref: Any) -> Any:
-    """``ref`` itself, or the object a lazy ``"module:attr"`` reference names."""
+def _resolve(ref: Any, name: str = "") -> Any:
+    """``ref`` itself, or the object a lazy ``"module:attr"`` reference names; a reference
+    that names nothing is a :class:`~ai.errors.PluginError` naming registration ``name``."""
     if isinstance(ref, str):
         module, _, attr = ref.partition(":")
-        return getattr(import_module(module), attr)
+        try:
+            return getattr(import_module(module), attr)
+        except (ImportError, AttributeError) as error:
+            raise PluginError(f"{name}: cannot import {ref!r} "
+                              f"({type(error).__name__}: {error})") from None
     return ref
 
 
@@ -64,9 +69,14 @@ class Registration(Generic[T]):
     params: type[Params] | str | None = None
 
     def build(self, params: Mapping[str, Any] | None = None) -> T:
-        """A fresh controller with ``params``."""
-        factory: Callable[[Mapping[str, Any] | None], T] = _resolve(self.factory)
-        return factory(params)
+        """A fresh controller with ``params``; :class:`~ai.errors.PluginError` if the factory
+        returns no guard team controller or player policy."""
+        factory: Callable[[Mapping[str, Any] | None], T] = _resolve(self.factory, self.name)
+        made = factory(params)
+        if not isinstance(made, (GuardAI, PlayerPolicy)):
+            raise PluginError(f"{self.name}: its factory returned {type(made).__name__}, not "
+                              "an ai.GuardAI or ai.PlayerPolicy")
+        return made
 
     def parameters(self) -> type[Params] | None:
         """The parameter dataclass (imported on first use), or None."""
@@ -74,7 +84,7 @@ class Registration(Generic[T]):
 
     @cached_property
     def _parameters(self) -> type[Params] | None:
-        return _resolve(self.params) if self.params is not None else None
+        return _resolve(self.params, self.name) if self.params is not None else None
 
 
 class Registry(MutableMapping[str, Registration[T]]):
@@ -84,8 +94,16 @@ class Registry(MutableMapping[str, Registration[T]]):
     the CLI, the config, a sweep's workers and play all see an installed mode; writing
     (registering) imports nothing."""
 
-    def __init__(self) -> None:
+    def __init__(self, what: str) -> None:
         self._entries: dict[str, Registration[T]] = {}
+        self._what = what
+        self._built_in: frozenset[str] = frozenset()
+
+    def seal(self) -> None:
+        """Fix the names registered so far as the built-in ones: no later registration (an
+        installed package, a notebook) may replace them, because that would change what
+        ``--guards pf`` and the ``paper`` preset run without a word."""
+        self._built_in = frozenset(self._entries)
 
     def __getitem__(self, name: str) -> Registration[T]:
         _load_installed()
@@ -100,16 +118,21 @@ class Registry(MutableMapping[str, Registration[T]]):
         return len(self._entries)
 
     def __setitem__(self, name: str, registration: Registration[T]) -> None:
+        if name in self._built_in:
+            raise ValueError(f"{name}: a built-in {self._what}; register yours under a name "
+                             "of its own")
         self._entries[name] = registration
 
     def __delitem__(self, name: str) -> None:
+        if name in self._built_in:
+            raise ValueError(f"{name}: a built-in {self._what} stays registered")
         del self._entries[name]
 
 
 def _load_installed() -> None:
     from .installed import load_installed
 
-    load_installed()
+    load_installed({"guard mode": GUARD_MODES._entries, "player policy": PLAYER_POLICIES._entries})
 
 
 def registrations() -> list[Registration[Any]]:
@@ -123,27 +146,66 @@ DEFAULT_GUARD_MODE = "pf"
 DEFAULT_PLAYER_POLICY = "maxmin"
 
 #: Registered guard modes by command-line name (SPEC §9 order: the order of play's keys).
-GUARD_MODES: Registry[GuardAI] = Registry()
+GUARD_MODES: Registry[GuardAI] = Registry("guard mode")
 #: Registered player policies by command-line name.
-PLAYER_POLICIES: Registry[PlayerPolicy] = Registry()
+PLAYER_POLICIES: Registry[PlayerPolicy] = Registry("player policy")
 
 
 def _registration(name: str, factory: Any, display: str | None, short: str | None,
                   abbrev: str | None, section: str,
                   params: type[Params] | str | None) -> Registration[Any]:
-    """A registration with its names filled in; refuses a section that another
-    registration fills with another parameter class (one section, one set of keys)."""
+    """A registration with its names filled in. Refuses (``ValueError`` naming the argument)
+    a name or section that is no word and a display, short or abbreviated name that is no
+    short line (:mod:`navmesh.names`), a factory that is neither callable nor a
+    ``"module:attr"`` reference, parameters that are no checked parameter class
+    (:meth:`ai.params.Params.declaration_problem`) nor such a reference, and a section that
+    another registration fills with another parameter class (one section, one set of keys).
+    """
+    _check_declaration(name, factory, display, short, abbrev, section, params)
     held_now: list[Registration[Any]] = [*GUARD_MODES._entries.values(),
                                          *PLAYER_POLICIES._entries.values()]  # loads nothing
     for other in held_now:
         held = other.parameters() if other.params is not None else None
         if (other.name != name and other.section == section and held is not None
-                and params is not None and other.params != params and held is not _resolve(params)):
+                and params is not None and other.params != params
+                and held is not _resolve(params, name)):
             raise ValueError(f"{name}: config section [{section}] already holds the parameters "
                              f"of {other.name!r} ({held.__name__})")
     display = display or name.title()
     short = short or display
     return Registration(name, factory, display, section, short, abbrev or short, params)
+
+
+def _check_declaration(name: Any, factory: Any, display: Any, short: Any, abbrev: Any,
+                       section: Any, params: Any) -> None:
+    from navmesh.names import label_problem, name_problem
+
+    problem = name_problem(name)
+    if problem is not None:
+        raise ValueError(f"name {problem}")
+    for what, value, check in (("section", section, name_problem),
+                               ("display", display, label_problem),
+                               ("short", short, label_problem), ("abbrev", abbrev, label_problem)):
+        problem = None if value is None else check(value)
+        if problem is not None:
+            raise ValueError(f"{name}: {what} {problem}")
+    if not (callable(factory) or _is_reference(factory)):
+        raise ValueError(f"{name}: factory must be callable or a 'module:attr' reference, "
+                         f"got {factory!r:.80}")
+    if params is not None and not _is_reference(params):
+        from .params import Params
+
+        problem = Params.declaration_problem(params)
+        if problem is not None:
+            raise ValueError(f"{name}: params {problem}")
+
+
+def _is_reference(ref: Any) -> bool:
+    """Whether ``ref`` is a lazy ``"module:attr"`` reference (resolved on first use)."""
+    if not isinstance(ref, str):
+        return False
+    module, sep, attr = ref.partition(":")
+    return bool(sep) and attr.isidentifier() and all(p.isidentifier() for p in module.split("."))
 
 
 def register_guard_mode(name: str, factory: Callable[..., GuardAI] | str, *,
@@ -167,13 +229,17 @@ def register_player_policy(name: str, factory: Callable[..., PlayerPolicy] | str
 
 
 def unregister_guard_mode(name: str) -> None:
-    """Remove a guard mode registered by :func:`register_guard_mode` (tests, notebooks)."""
-    GUARD_MODES._entries.pop(name, None)
+    """Remove a guard mode registered by :func:`register_guard_mode` (tests, notebooks); a
+    built-in one stays."""
+    if name not in GUARD_MODES._built_in:
+        GUARD_MODES._entries.pop(name, None)
 
 
 def unregister_player_policy(name: str) -> None:
-    """Remove a player policy registered by :func:`register_player_policy`."""
-    PLAYER_POLICIES._entries.pop(name, None)
+    """Remove a player policy registered by :func:`register_player_policy`; a built-in one
+    stays."""
+    if name not in PLAYER_POLICIES._built_in:
+        PLAYER_POLICIES._entries.pop(name, None)
 
 
 class Names(Mapping[str, str]):
@@ -238,6 +304,8 @@ register_player_policy("maxmin", "ai.players:MaxMinPlayer", display="MaxMin", sh
 register_player_policy("safetygraph", "ai.players:SafetyGraphPlayer", display="SafetyGraph",
                        short="SG", params="ai.params:PlayerParams")
 register_player_policy("evade", "ai.players:EvadePlayer", display="Evade", short="EV")
+GUARD_MODES.seal()  # the names above are the built-in ones: nothing replaces them
+PLAYER_POLICIES.seal()
 
 __all__ = [
     "DEFAULT_GUARD_MODE", "DEFAULT_PLAYER_POLICY", "Event", "GuardAI", "Names", "PlayerPolicy",

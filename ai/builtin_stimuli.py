@@ -10,7 +10,7 @@ from typing import Any
 
 import numpy as np
 
-from .stimulus import FieldContext, Rule, Sound, Stimulus, register_stimulus
+from .stimulus import FieldContext, Rule, Sound, Stimulus, register_stimulus, seal_built_in
 from .view import Event, WorldView
 
 
@@ -271,3 +271,6 @@ DEFAULT_RULES: dict[str, Rule] = {
     "guard_down": corpse_rule,
     "weather": weather_rule,
 }
+
+
+seal_built_in()  # the mechanics above keep their names: a plugin named "corpse" is refused

@@ -56,6 +56,35 @@ class Params:
         return _CONFIG_DEFAULTS[cls]
 
     @classmethod
+    def declaration_problem(cls, params: Any) -> str | None:
+        """Why ``params`` cannot be a registration's parameter class, or None: it must be a
+        dataclass subclass of ``Params`` whose ``bounds`` gives every field a :mod:`ai.bounds`
+        bound and names no other, and whose defaults lie within them (checked when a mode or
+        stimulus is registered, not when a trial first builds it)."""
+        from dataclasses import is_dataclass
+
+        if not (isinstance(params, type) and issubclass(params, cls) and is_dataclass(params)):
+            return f"must be a dataclass subclass of ai.params.Params, got {params!r:.80}"
+        names = [f.name for f in fields(params)]
+        if not isinstance(params.bounds, Mapping):
+            return f"{params.__name__}.bounds must map each field to its bound"
+        for key, bound in params.bounds.items():
+            if key not in names:
+                return f"{params.__name__}.bounds names {key!r}, which is no field"
+            if not isinstance(bound, (Range, OneOf)):
+                return (f"{params.__name__}.bounds[{key!r}] must be an ai.bounds bound "
+                        f"(Range, OneOf), got {bound!r:.80}")
+        unbounded = [k for k in names if k not in params.bounds]
+        if unbounded:
+            return (f"{params.__name__}.{unbounded[0]} declares no bound (its bounds maps each "
+                    "field to its allowed values)")
+        try:
+            params()
+        except (TypeError, ValueError) as error:
+            return f"{params.__name__}: {error}"
+        return None
+
+    @classmethod
     def from_mapping(cls: type[_P], params: Mapping[str, Any] | None = None) -> _P:
         """Defaults overridden by ``params``; an unknown key or a bad value raises ValueError."""
         known = [f.name for f in fields(cls)]  # type: ignore[arg-type]

@@ -12,7 +12,7 @@ from typing import Any
 from navmesh.level import register_zone_kind
 
 from .errors import StimulusError
-from .installed import load_entry_point
+from .installed import load_entry_point, plugin_code
 from .stimulus import Measure, Stimulus, register_stimulus
 
 #: importlib.metadata entry-point group under which installed packages register stimuli
@@ -34,14 +34,11 @@ def _load_file(path: Path) -> Any:
     module = importlib.util.module_from_spec(spec)
     sys.modules[name] = module
     try:
-        spec.loader.exec_module(module)
-    except Exception as error:  # the user's file: report it in one line
+        with plugin_code(f"{path}: cannot load", StimulusError):  # the user's file: one line
+            spec.loader.exec_module(module)
+    except BaseException:
         del sys.modules[name]
-        raise StimulusError(f"{path}: cannot load: {type(error).__name__}: {error}") from None
-    except SystemExit as exit_:  # sys.exit() at import: the command must not end silently
-        del sys.modules[name]
-        raise StimulusError(f"{path}: cannot load: it called sys.exit({exit_.code!r}) "
-                            "while being imported") from None
+        raise
     module.__stealthfield_mtime__ = mtime  # type: ignore[attr-defined]
     return module
 

@@ -11,12 +11,13 @@ name (the built-ins, the plugins loaded). The built-in mechanics are in
 from __future__ import annotations
 
 from collections.abc import Callable, Iterable, Mapping
-from dataclasses import dataclass, field, is_dataclass
+from dataclasses import dataclass, field
 from typing import Any, ClassVar, NamedTuple
 
 import numpy as np
 
 from navmesh.graph import UNREACHABLE_HOPS, NodeGraph
+from navmesh.names import label_problem, name_problem
 
 from . import plugin_call, registrations
 from .errors import StimulusError
@@ -332,18 +333,28 @@ STIMULUS_TYPES: dict[str, type[Stimulus]] = {}
 
 
 def register_stimulus(cls: type[Stimulus]) -> type[Stimulus]:
-    """Make stimulus class ``cls`` known by its name (a plugin loaded again replaces its
-    older self) and return it. Refuses (:class:`StimulusError`) parameters that are no
+    """Make stimulus class ``cls`` known by its name and return it. Refuses
+    (:class:`StimulusError`) a name or section that is no word and a display or short name
+    that is no short line (:mod:`navmesh.names`); the name of a built-in stimulus (a plugin
+    named ``corpse`` would change the built-in corpse's markers; a plugin loaded again
+    replaces its older self); parameters that are no
     :class:`~ai.params.Params` dataclass with a bound for every field and defaults within
-    them, or a section that holds a guard mode's, a player policy's or another stimulus's
-    parameters.
+    them (:meth:`~ai.params.Params.declaration_problem`); or a section that holds a guard
+    mode's, a player policy's or another stimulus's parameters.
     """
     name = cls.name
-    if not isinstance(name, str) or not name:
-        raise StimulusError(f"{cls.__name__}: name must be a non-empty string, got {name!r}")
-    for attr in ("display", "short", "section"):
-        if not isinstance(getattr(cls, attr), str) or not getattr(cls, attr):
-            raise StimulusError(f"{name}: {attr} must be a non-empty string")
+    problem = name_problem(name)
+    if problem is not None:
+        raise StimulusError(f"{cls.__name__}: name {problem}")
+    for attr, check in (("section", name_problem), ("display", label_problem),
+                        ("short", label_problem)):
+        problem = check(getattr(cls, attr))
+        if problem is not None:
+            raise StimulusError(f"{name}: {attr} {problem}")
+    held = STIMULUS_TYPES.get(name)
+    if held is not None and held is not cls and name in _BUILT_IN:
+        raise StimulusError(f"{name}: a built-in stimulus ({held.__module__}."
+                            f"{held.__qualname__}); give the stimulus a name of its own")
     params = cls.parameters
     if params is not None:
         _check_parameters(cls, params)
@@ -351,19 +362,21 @@ def register_stimulus(cls: type[Stimulus]) -> type[Stimulus]:
     return cls
 
 
+#: the names of the built-in mechanics (:func:`seal_built_in`): no plugin takes them
+_BUILT_IN: set[str] = set()
+
+
+def seal_built_in() -> None:
+    """Fix the names registered so far as the built-in mechanics' (:mod:`ai.builtin_stimuli`
+    calls it once they are registered)."""
+    _BUILT_IN.update(STIMULUS_TYPES)
+
+
 def _check_parameters(cls: type[Stimulus], params: Any) -> None:
     name, section = cls.name, cls.section
-    if not (isinstance(params, type) and issubclass(params, Params) and is_dataclass(params)):
-        raise StimulusError(f"{name}: parameters must be a dataclass subclass of "
-                            f"ai.params.Params, got {params!r}")
-    unbounded = [k for k in params.config_defaults() if k not in params.bounds]
-    if unbounded:
-        raise StimulusError(f"{name}: parameters {params.__name__}.{unbounded[0]} declares "
-                            "no bound (its bounds maps each field to its allowed values)")
-    try:
-        params()
-    except (TypeError, ValueError) as error:
-        raise StimulusError(f"{name}: parameters {params.__name__}: {error}") from None
+    problem = Params.declaration_problem(params)
+    if problem is not None:
+        raise StimulusError(f"{name}: parameters {problem}")
     taken = [f"{r.name!r}" for r in registrations() if r.section == section]
     taken += [f"stimulus {other.name!r}" for other in STIMULUS_TYPES.values()
               if other.section == section and other.parameters is not None
@@ -375,8 +388,9 @@ def _check_parameters(cls: type[Stimulus], params: Any) -> None:
 
 def unregister_stimulus(name: str) -> None:
     """Forget the stimulus class registered as ``name`` (tests, notebooks): its config
-    section is gone from configs made afterwards."""
-    STIMULUS_TYPES.pop(name, None)
+    section is gone from configs made afterwards. A built-in one stays."""
+    if name not in _BUILT_IN:
+        STIMULUS_TYPES.pop(name, None)
 
 
 # ---------------------------------------------------------------------------- event rules

@@ -128,13 +128,14 @@ def _cmd_play(args: argparse.Namespace) -> int:
     from game.config_file import read_config_file
     from game.front.play_command import cmd_play
 
-    from .outputs.clobber import level_file, plugin_files, refuse_inputs_all
+    from .outputs.clobber import level_file, plugin_files, refuse_inputs, refuse_inputs_all
 
     if args.questions and args.record is None:
         raise UsageError("--questions: the ratings are stored with the session: give --record DIR too")
     inputs = [level_file(args.level), args.config, *plugin_files(args.stimulus)]
-    refuse_inputs_all("--screenshot/--record", [p for p in (args.screenshot, args.record) if p],
-                      inputs)
+    refuse_inputs_all("--screenshot", [args.screenshot] if args.screenshot else [], inputs)
+    if args.record:
+        refuse_inputs("--record", args.record, inputs, folder=True)
     if args.config:  # the file's overrides first, so --set still wins
         args.set = [f"{k}={v}" for k, v in read_config_file(args.config).items()] + args.set
     if args.record is None:

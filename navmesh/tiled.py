@@ -44,6 +44,7 @@ from pytiled_parser import tiled_object as to
 from shapely.geometry import Polygon, box
 
 from navmesh.errors import LevelError, LevelWarning
+from navmesh.level_fields import zone_kinds
 from navmesh.level_format import Level, parse_level
 from navmesh.tiled_classes import OBSTACLE, OUTLINE, WALLS, TiledClass, object_classes
 from navmesh.tiled_guard import MapFiles, check_map_cells
@@ -119,7 +120,7 @@ def tiled_level_data(path: Path, source: str, raw: bytes | None = None
         _fail(source, "map", f"tiles {tile_w} pixels wide are not supported; tiles are at "
                              f"most {MAX_TILE_PIXELS} pixels wide")
     cell_size = _cell_size(tmap, source)
-    found = _Collected({c.name: c for c in object_classes()})
+    found = _Collected({c.name: c for c in object_classes(zone_kinds())})
     _collect(tmap.layers, "", 0.0, 0.0, found, source)
     tile = float(tile_w)
     for cls in found.classes.values():

@@ -19,8 +19,6 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Iterable
 
-from navmesh.level_fields import ZONE_KINDS, zone_kinds
-
 __all__ = ["AREA", "AREAS", "BUILT_IN", "COLLECTIBLE", "DECOY", "EXIT", "GUARD", "OBSTACLE",
            "OUTLINE", "PLAYER", "POINT", "POINTS", "TILES", "WALLS", "TiledClass",
            "markdown_table", "object_classes", "tiled_classes", "zone_class"]
@@ -91,20 +89,21 @@ def zone_class(kind: str) -> TiledClass:
     return TiledClass(kind, AREAS, f"zones.{kind}", f"a zone of kind `{kind}`")
 
 
-def tiled_classes(kinds: Iterable[str] | None = None) -> tuple[TiledClass, ...]:
-    """Every class: the built-in ones, then one per zone kind (``kinds``, by default
-    :func:`~navmesh.level_fields.zone_kinds`, the kinds known now)."""
-    return BUILT_IN + tuple(zone_class(k) for k in (zone_kinds() if kinds is None else kinds))
+def tiled_classes(kinds: Iterable[str]) -> tuple[TiledClass, ...]:
+    """Every class: the built-in ones, then one per zone kind (``kinds``: the kinds known
+    now are :func:`~navmesh.level_fields.zone_kinds`)."""
+    return BUILT_IN + tuple(zone_class(k) for k in kinds)
 
 
-def object_classes(kinds: Iterable[str] | None = None) -> tuple[TiledClass, ...]:
+def object_classes(kinds: Iterable[str]) -> tuple[TiledClass, ...]:
     """The classes an object may have (all but the tile layers')."""
     return tuple(c for c in tiled_classes(kinds) if c.becomes != TILES)
 
 
-def markdown_table(kinds: Iterable[str] = ZONE_KINDS) -> str:
-    """The class table of ``docs/levels.md``: each class with its shape and what it becomes;
-    the last row stands for the zone kinds a stimulus registers."""
+def markdown_table(kinds: Iterable[str]) -> str:
+    """The class table of ``docs/levels.md`` (``kinds``: the built-in zone kinds): each class
+    with its shape and what it becomes; the last row stands for the kinds a stimulus
+    registers."""
     lines = ["| class | shape | becomes |", "|---|---|---|"]
     for c in tiled_classes(kinds):
         notes = [c.description + (f" (`{c.field}`)" if c.field else "")]

@@ -102,7 +102,7 @@ def test_bad_declarations_are_one_line_errors(tmp_path: Path) -> None:
         "class Meas(Stimulus):\n    measure = 'captured'\n"
     )
     for name, message in (("Kinds", "zone_kinds must be a tuple of strings"),
-                          ("Spaces", "zone_kinds: a zone kind is a non-empty string"),
+                          ("Spaces", "zone_kinds: a zone kind must be a word"),
                           ("Meas", "measure must be an ai.stimuli.Measure")):
         with pytest.raises(StimulusError, match=message):
             load_stimulus(f"{plugin}:{name}")

@@ -13,7 +13,7 @@ import navmesh.level_fields as level_fields
 from headless.cli import main
 from navmesh.errors import LevelError, LevelWarning
 from navmesh.level import load_level, register_zone_kind
-from navmesh.level_fields import ZONE_KINDS
+from navmesh.level_fields import ZONE_KINDS, zone_kinds
 from navmesh.tiled_classes import BUILT_IN, markdown_table, object_classes, tiled_classes
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -38,17 +38,17 @@ def test_class_names_are_written_only_in_the_registry() -> None:
 
 def test_docs_list_every_class() -> None:
     text = (ROOT / "docs" / "levels.md").read_text(encoding="utf-8")
-    assert markdown_table() in text
-    rows = [line for line in markdown_table().splitlines() if line.startswith("| `")]
+    assert markdown_table(ZONE_KINDS) in text
+    rows = [line for line in markdown_table(ZONE_KINDS).splitlines() if line.startswith("| `")]
     assert len(rows) == len(tiled_classes(ZONE_KINDS))
 
 
 def test_the_object_classes_are_the_built_in_ones_then_the_zone_kinds(monkeypatch) -> None:
     monkeypatch.setattr(level_fields, "_zone_kinds", list(ZONE_KINDS))
     register_zone_kind("smoke")
-    names = [c.name for c in object_classes()]
+    names = [c.name for c in object_classes(zone_kinds())]
     assert names == [c.name for c in BUILT_IN if c.name != "walls"] + [*ZONE_KINDS, "smoke"]
-    assert [c.name for c in tiled_classes() if c.single] == ["player", "outline"]
+    assert [c.name for c in tiled_classes(zone_kinds()) if c.single] == ["player", "outline"]
 
 
 def test_a_registered_zone_kind_is_a_tiled_class(tmp_path, monkeypatch, capsys) -> None:

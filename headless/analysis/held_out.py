@@ -246,13 +246,12 @@ def run(argv: Sequence[str], prog: str = "python -m headless.held_out") -> int:
         label = (f"held-out seeds {seeds[0]}–{seeds[-1]}" if len(seeds) > 1
                  else f"seed {seeds[0]}")
         text = held_out_markdown(ours, label, baseline)
-        if args.figure is not None:
-            plot_errors(ours, args.figure, f"{args.dir.name}, {label}")
         if args.write is None:
             sys.stdout.write(text)
-            return 0
-        if not replace_marked(args.write, _BEGIN, _END, text):
+        elif not replace_marked(args.write, _BEGIN, _END, text):  # first: it may be refused
             raise UserError(f"{args.write}: no {_BEGIN} ... {_END} markers")
+        if args.figure is not None:
+            plot_errors(ours, args.figure, f"{args.dir.name}, {label}")
         return 0
     except (UserError, OSError) as error:
         print(f"stealth: error: {error}", file=sys.stderr)

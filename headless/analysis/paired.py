@@ -19,6 +19,7 @@ from typing import Any
 import numpy as np
 
 from ..commands.failure import GuardedParser, guarded, wants_debug
+from ..errors import UserError
 from .stats import bootstrap_ci
 from ..store import STORE_NAME, ResultStore
 
@@ -43,11 +44,17 @@ def _load(directory: Path, guards: str | None, across: bool = False,
                 if guards is None or t["guards"] == guards}
 
 
-def _value(trial: Mapping[str, Any], metric: str, missing: float | None) -> float:
-    value = trial[metric]
+def _value(trial: Mapping[str, Any], metric: str, missing: float | None,
+           directory: Path) -> float:
+    """The trial's ``metric``; a store written before the metric existed, or a trial
+    without it, is a :class:`~headless.errors.UserError` naming the store."""
+    value = trial.get(metric)
     if value is None:
         if missing is None:
-            raise ValueError(f"trial {trial['key']}: {metric} is missing")
+            what = ("has no column" if metric not in trial
+                    else f"trial {str(trial['key'])[:60]} has no value")
+            raise UserError(f"{directory}: {what} for {metric} (a store of another version "
+                            "or a failed trial); compare stores of the same version")
         return missing
     return float(value)
 
@@ -59,18 +66,23 @@ def paired_rows(arm: Path, control: Path, guards: str | None = None,
     ``control_guards`` pairs the arm's ``guards`` trials with that mode's in the control.
     """
     if control_guards is not None and guards is None:
-        raise ValueError("control_guards needs guards")
+        raise UserError("control_guards needs guards")
     across = control_guards is not None
     a = _load(arm, guards, across)
     c = _load(control, control_guards if across else guards, across)
     scenario_at = _PAIR_KEY.index("scenario") - (1 if across else 0)
     keys = sorted(set(a) & set(c))
+    if not keys:
+        mode = "" if guards is None else f" of guard mode {guards!r}" + (
+            f" and {control_guards!r}" if across else "")
+        raise UserError(f"{arm} and {control}: no trial{mode} with the same level, "
+                        "abstraction, player, scenario and seed in both")
     out = []
     for name, scenario, metric, missing in MEASURES:
         for env in (*sorted({k[1] for k in keys}), "both"):
             ks = [k for k in keys if k[scenario_at] == scenario and env in (k[1], "both")]
-            x = np.array([_value(a[k], metric, missing) for k in ks])
-            y = np.array([_value(c[k], metric, missing) for k in ks])
+            x = np.array([_value(a[k], metric, missing, arm) for k in ks])
+            y = np.array([_value(c[k], metric, missing, control) for k in ks])
             label = f"paired/{name}/{env}"
             out.append({"measure": name, "env": env, "pairs": len(ks),
                         "arm": (float(x.mean()) if len(x) else float("nan"),

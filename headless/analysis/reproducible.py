@@ -11,6 +11,8 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any
 
+from ..errors import UserError
+
 __all__ = ["HASH_SALT", "save_figure"]
 
 HASH_SALT = "stealthfield"
@@ -24,8 +26,14 @@ _METADATA: dict[str, dict[str, Any]] = {
 
 
 def save_figure(fig: Any, path: str | Path, **kwargs: Any) -> None:
-    """``fig.savefig(path, **kwargs)`` with a fixed SVG salt and no dates in the file."""
+    """``fig.savefig(path, **kwargs)`` with a fixed SVG salt and no dates in the file. A
+    ``path`` that is a directory is a :class:`~navmesh.errors.UserError` (matplotlib would
+    write ``path.png`` beside it without a word)."""
     import matplotlib
+
+    if Path(path).is_dir():
+        raise UserError(f"{path}: is a directory; a figure is written to a file (e.g. "
+                        f"{Path(path) / 'figure.png'})")
 
     kind = Path(path).suffix.lstrip(".").lower() or str(matplotlib.rcParams["savefig.format"])
     metadata = {**_METADATA.get(kind, {}), **kwargs.pop("metadata", {})}

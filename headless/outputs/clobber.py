@@ -4,7 +4,8 @@ Opening an output for writing truncates it, so ``stealth sim LEVEL --trace LEVEL
 destroy the level before the first tick, and ``sim --from DIR --trial KEY --trace
 DIR/results.sqlite`` the store it reads. :func:`refuse_inputs` is called by every command
 that writes a file (``sim --trace``, ``play``/``replay --screenshot``, ``report``,
-``mechanics``, ``tune``, the analyses' ``--write``/``--figure``) before anything is opened.
+``mechanics``, ``tune``, the analyses' ``--write``/``--figure``) before anything is opened,
+and refuses a directory where a file is to be written.
 It compares the output with the command's input files by identity
 (:func:`os.path.samefile`: the same file under another name, a symlink or a hard link
 included) and refuses any existing SQLite file (a results store or a study): no command
@@ -34,8 +35,11 @@ def is_store_file(path: str | Path) -> bool:
         return False
 
 
-def refuse_inputs(option: str, output: str | Path, inputs: Iterable[str | Path | None]) -> None:
-    """Raise a one-line :class:`UserError` if ``output`` is one of ``inputs`` or a store.
+def refuse_inputs(option: str, output: str | Path, inputs: Iterable[str | Path | None],
+                  folder: bool = False) -> None:
+    """Raise a one-line :class:`UserError` if ``output`` is one of ``inputs`` or a store,
+    or an existing directory where a file is written (``folder``: the output is a folder,
+    as ``play --record``'s), so a command refuses it before it writes any other output.
 
     >>> import tempfile
     >>> level = Path(tempfile.mkdtemp()) / "level.json"
@@ -48,6 +52,8 @@ def refuse_inputs(option: str, output: str | Path, inputs: Iterable[str | Path |
     target = Path(output)
     if not target.exists():
         return
+    if target.is_dir() and not folder:
+        raise UserError(f"{option} {output}: is a directory; it names a file")
     for source in inputs:
         if source is None:
             continue
