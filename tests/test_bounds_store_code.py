@@ -88,7 +88,7 @@ def test_an_old_store_without_zone_kinds_is_reported_after_one_note(shared: Path
     ("design", "[1, 2]", "meta.design is list"),
     ("zone_kinds", '" alarm"', "meta.zone_kinds is not a list"),
     ("zone_kinds", json.dumps([f"k{i}" for i in range(100_000)]), "more than 256"),
-    ("zone_kinds", '[" alarm"]', "a zone kind is a non-empty string"),
+    ("zone_kinds", '[" alarm"]', "a zone kind must be a word"),
 ], ids=["not-json", "a-list", "a-string", "many-kinds", "bad-kind"])
 def test_a_bad_design_is_one_line(shared: Path, key: str, value: str, words: str) -> None:
     _set_meta(shared, key, value)
