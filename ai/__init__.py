@@ -128,11 +128,22 @@ class Registry(MutableMapping[str, Registration[T]]):
             raise ValueError(f"{name}: a built-in {self._what} stays registered")
         del self._entries[name]
 
+    def held(self) -> dict[str, Registration[T]]:
+        """The registrations made so far, without importing the installed plugins (what a
+        registration is checked against, and what :func:`ai.installed.load_installed`
+        compares before and after each entry point)."""
+        return self._entries
+
+    def discard(self, name: str) -> None:
+        """Remove ``name`` if it is registered and not a built-in (tests, notebooks)."""
+        if name not in self._built_in:
+            self._entries.pop(name, None)
+
 
 def _load_installed() -> None:
     from .installed import load_installed
 
-    load_installed({"guard mode": GUARD_MODES._entries, "player policy": PLAYER_POLICIES._entries})
+    load_installed({"guard mode": GUARD_MODES.held(), "player policy": PLAYER_POLICIES.held()})
 
 
 def registrations() -> list[Registration[Any]]:
@@ -162,8 +173,8 @@ def _registration(name: str, factory: Any, display: str | None, short: str | Non
     another registration fills with another parameter class (one section, one set of keys).
     """
     _check_declaration(name, factory, display, short, abbrev, section, params)
-    held_now: list[Registration[Any]] = [*GUARD_MODES._entries.values(),
-                                         *PLAYER_POLICIES._entries.values()]  # loads nothing
+    held_now: list[Registration[Any]] = [*GUARD_MODES.held().values(),
+                                         *PLAYER_POLICIES.held().values()]  # loads nothing
     for other in held_now:
         held = other.parameters() if other.params is not None else None
         if (other.name != name and other.section == section and held is not None
@@ -231,15 +242,13 @@ def register_player_policy(name: str, factory: Callable[..., PlayerPolicy] | str
 def unregister_guard_mode(name: str) -> None:
     """Remove a guard mode registered by :func:`register_guard_mode` (tests, notebooks); a
     built-in one stays."""
-    if name not in GUARD_MODES._built_in:
-        GUARD_MODES._entries.pop(name, None)
+    GUARD_MODES.discard(name)
 
 
 def unregister_player_policy(name: str) -> None:
     """Remove a player policy registered by :func:`register_player_policy`; a built-in one
     stays."""
-    if name not in PLAYER_POLICIES._built_in:
-        PLAYER_POLICIES._entries.pop(name, None)
+    PLAYER_POLICIES.discard(name)
 
 
 class Names(Mapping[str, str]):
