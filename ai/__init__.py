@@ -78,6 +78,11 @@ class Registration(Generic[T]):
                               "an ai.GuardAI or ai.PlayerPolicy")
         return made
 
+    def build_for(self, config: Any) -> T:
+        """A fresh controller with its section's values of ``config`` (anything with a
+        ``section(name)`` mapping, e.g. a :class:`game.config.Config`)."""
+        return self.build(config.section(self.section))
+
     def parameters(self) -> type[Params] | None:
         """The parameter dataclass (imported on first use), or None."""
         return self._parameters

@@ -108,7 +108,7 @@ def make_world(
         level = cached_level(spec.level)
     if controllers is None:
         guards = guard_mode(spec.guards)
-        controllers = (guards.build(config.section(guards.section)),
+        controllers = (guards.build_for(config),
                        player_policy(spec.player).build(
                            player_params(config, spec.scenario, spec.player)))
     guard_ai, player = controllers

@@ -383,15 +383,13 @@ def parse_preset(
 
     for mode in guards:
         try:
-            registration = guard_mode(mode)
-            registration.build(config.section(registration.section))
+            guard_mode(mode).build_for(config)
         except Exception as error:  # a mode that is listed but cannot be built
             raise _fail(src, "guards", f"{mode}: cannot be loaded "
                                        f"({type(error).__name__}: {error})") from None
     for policy in players:
         try:
-            policy_registration = player_policy(policy)
-            policy_registration.build(config.section(policy_registration.section))
+            player_policy(policy).build_for(config)
         except Exception as error:
             raise _fail(src, "players", f"{policy}: cannot be loaded "
                                         f"({type(error).__name__}: {error})") from None

@@ -242,8 +242,7 @@ class Match:
             guard_ai: Any = self.guards
         else:
             self.guards = None
-            mode = guard_mode(self.guard_mode)
-            guard_ai = mode.build(self.config.section(mode.section))
+            guard_ai = guard_mode(self.guard_mode).build_for(self.config)
         spec = TrialSpec(level=self.level.name, abstraction=self.abstraction,
                          guards=self.guard_mode or "external", player="external",
                          scenario=self.scenario, seed=seed)
