@@ -253,10 +253,10 @@ class Locomotion:
 
     def settle(self, agent: Agent, before: tuple[float, float], speed: float,
                stuck_timeout: float) -> bool:
-        """After a physics step: read the body, pop reached waypoints, and re-plan an agent
+        """After a physics step (``agent.pos`` read from the body, or set by the batch
+        engine): pop reached waypoints, and re-plan an agent
         stuck for ``stuck_timeout`` s (:meth:`replan`; stuck again, its plan is cleared and
         its controller decides anew). True when the agent has just reached its target."""
-        agent.sync()
         x, y = agent.pos
         moved = math.hypot(x - before[0], y - before[1])
         agent.on_track = abs(moved - speed * self.dt) < 1e-9

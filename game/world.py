@@ -196,23 +196,48 @@ class World(PlayerActions):
         )
 
     def step(self) -> None:
-        """Advance the world by one physics step (decisions, motion, senses, AI tick)."""
+        """Advance the world by one physics step (decisions, motion, senses, AI tick).
+
+        The phases are methods of their own so the batch engine (:mod:`game.batch`), which
+        moves and senses many trials at once over arrays, calls the same rules for the
+        events (decisions, arrivals, damage, sightings, ticks) of each of its trials.
+        """
         if self.done:
             return
+        if self.step_index % self.steps_per_decision == 0:  # always, unless gated
+            self.decide()
+        player_speed = self.drive()
+        agents = [*self.guards, self.player]
+        before = [a.pos for a in agents]
+        sprint = self.sprinting
+        self.space.step(self.dt)
+        self.step_index += 1
+        before[-1] = self.hurt(before[-1])
+        for i, (agent, speed) in enumerate(zip(agents, self.speeds(player_speed), strict=True)):
+            agent.sync()
+            self.settle_agent(i, agent, before[i], speed)
+        self.moved(before[-1], sprint)
+        self._sense()
+        self.end_step()
+
+    def decide(self) -> None:
+        """A decision tick: every active guard and the player without a plan decide."""
         walk = self.locomotion
         view = None
-        decide = self.step_index % self.steps_per_decision == 0  # always, unless gated
         for i, guard in enumerate(self.guards):
-            if decide and guard.active and guard.needs_decision:
+            if guard.active and guard.needs_decision:
                 view = view or self.view()
                 walk.plan(guard, int(self.guard_ai.decide(i, view)))
-        if (decide and self.player_input is None and self.player_policy is not None
+        if (self.player_input is None and self.player_policy is not None
                 and self.player.needs_decision):
             view = view or self.view()
             walk.plan(self.player, int(self.player_policy.decide(view)))
             for action in self.player_policy.actions(view):
                 self.perform(action)
 
+    def drive(self) -> float:
+        """Set every body's velocity for the coming step; returns the player's speed."""
+        walk = self.locomotion
         for guard in self.guards:
             walk.drive(guard, guard.speed)
         player_speed = self.player_speed * (self.sprint_factor if self.sprinting else 1.0)
@@ -223,27 +248,34 @@ class World(PlayerActions):
                 self.player.heading = math.atan2(vy, vx)
         else:
             walk.drive(self.player, player_speed)
+        return player_speed
 
-        agents = [*self.guards, self.player]
-        before = [a.pos for a in agents]
-        sprint = self.sprinting
-        self.space.step(self.dt)
-        self.step_index += 1
+    def speeds(self, player_speed: float) -> list[float]:
+        """The speed each agent walks at this step: the guards', then the player's."""
+        return [g.speed for g in self.guards] + [player_speed]
+
+    def hurt(self, before: tuple[float, float]) -> tuple[float, float]:
+        """Damage from the guards in range at the start of the step; returns where the
+        player's step counts from (``before``, or the respawn point: a teleport, not a walk,
+        so no footsteps and no stall)."""
         if self.attackers:
             # Guards in range at the start of the step hurt over the whole step, so a
             # player in range from t0 on dies at exactly t0 + HP (per guard).
             self.m.attacks[self.player.node] += self.attackers * self.dt
             if self.health.hurt(self.attackers):
                 self._captured()
-                if not self.done:  # respawned: a teleport, not a walk (no footsteps, no stall)
-                    before[-1] = self.player.pos
+                if not self.done:
+                    return self.player.pos
+        return before
 
-        self._settle_agents(agents, before, [g.speed for g in self.guards] + [player_speed])
-        self.player_moved = self.player.pos != before[-1]
+    def moved(self, before: tuple[float, float], sprint: bool) -> None:
+        """Whether the player moved this step (footsteps while sprinting)."""
+        self.player_moved = self.player.pos != before
         if sprint and self.player_moved:
             self._sprinted = True  # footsteps: the player moved while sprinting this tick
 
-        self._sense()
+    def end_step(self) -> None:
+        """The AI tick when one is due; the end of the trial when its time is up."""
         if self.step_index % self.steps_per_tick == 0:
             self._ai_tick()
         if self.step_index >= self.total_steps:
@@ -253,10 +285,11 @@ class World(PlayerActions):
         """End the trial now (a script that has seen what it waited for)."""
         self.done = True
 
-    def _settle_agents(self, agents: list[Agent], before: list[tuple[float, float]],
-                       speeds: list[float]) -> None:
-        """Stop the agents that arrived and enter the nodes they stand on (the player last:
-        its arrivals are not scored).
+    def settle_agent(self, index: int, agent: Agent, before: tuple[float, float],
+                     speed: float) -> None:
+        """After a physics step, agent number ``index`` (the guards, then the player; its
+        position read): stop it if it arrived and enter the node it stands on (the player's
+        arrivals are not scored).
 
         An agent that has reached its target stands on it, and keeps its node until it moves.
         That is not always the node under its centre: on the partition a body stops on the
@@ -264,18 +297,16 @@ class World(PlayerActions):
         is within a body radius of a wall (the slivers by a thin wall's end). Read from the
         centre, the controller never saw it arrive and sent it there again, for ever (issue 24).
         """
-        walk, node_near, last = self.locomotion, self.graph.node_near, len(agents) - 1
-        for i, (agent, speed) in enumerate(zip(agents, speeds, strict=True)):
-            if walk.settle(agent, before[i], speed, self.stuck_timeout):
-                if i < last:
-                    self.m.count_arrival(agent.history, agent.target)
-                node = agent.target
-            elif agent.pos == before[i]:
-                continue
-            else:
-                node = node_near(agent.pos[0], agent.pos[1], agent.node)
-            if node != agent.node:
-                self._enter_node(agent, node, i)
+        if self.locomotion.settle(agent, before, speed, self.stuck_timeout):
+            if agent is not self.player:
+                self.m.count_arrival(agent.history, agent.target)
+            node = agent.target
+        elif agent.pos == before:
+            return
+        else:
+            node = self.graph.node_near(agent.pos[0], agent.pos[1], agent.node)
+        if node != agent.node:
+            self._enter_node(agent, node, index)
 
     def _enter_node(self, agent: Agent, node: int, index: int) -> None:
         """``agent`` (guard number ``index``, or the player) now stands on ``node``."""
@@ -291,15 +322,20 @@ class World(PlayerActions):
         reach = self.view_reach()  # once per step, not once per guard
         seeing, attackers, nodes, positions = _guard_senses(
             self.guards, self.senses, ppos, reach, self.attack_range, self.attack_los)
+        self.detect(seeing)
+        self.attackers = attackers
+        if self.step_index > 0:
+            self.m.sample_distance(self.graph, self.player.node, nodes)
+            self.m.sample_euclidean(ppos, positions)
+
+    def detect(self, seeing: Sequence[int]) -> None:
+        """The guards ``seeing`` the player now become the team's detections (``seen_by``,
+        the sighting, the first detection time)."""
         self.seen_by = self.team.detect(self, tuple(seeing))
         if self.seen_by:
             self.sighting = self.player.node
             if self.m.first_detect_time is None:
                 self.m.first_detect_time = self.t
-        self.attackers = attackers
-        if self.step_index > 0:
-            self.m.sample_distance(self.graph, self.player.node, nodes)
-            self.m.sample_euclidean(ppos, positions)
 
     def _captured(self) -> None:
         self.m.count_capture(self.t)
