@@ -164,19 +164,27 @@ def run_trial(
     started = time.perf_counter()
     if world is None:
         world = make_world(spec)
-    config = world.config
     writer = attach_trace(world, trace, explain=explain) if trace is not None else None
     metrics = world.run()
     if writer is not None:
         writer.finish(world)
+    return trial_row(spec, world, time.perf_counter() - started, metrics)
+
+
+def trial_row(spec: TrialSpec, world: World, wall_time: float,
+              metrics: dict[str, Any] | None = None) -> dict[str, Any]:
+    """The row of a trial whose ``world`` has ended (either engine makes it here):
+    identity, config hash, metrics (``world.metrics()`` unless given), heatmaps and the
+    seconds it took."""
+    config = world.config
     return {
         **identity_row(spec, world.level.name),
         "config_hash": config.hash(),
         "config": config.as_dict(),
-        "metrics": metrics,
+        "metrics": world.metrics() if metrics is None else metrics,
         "visits": world.m.visits.tolist(),
         "attacks": [round(a, 6) for a in world.m.attacks.tolist()],
-        "wall_time": time.perf_counter() - started,
+        "wall_time": wall_time,
     }
 
 
@@ -197,4 +205,4 @@ def sim_document(row: Mapping[str, Any]) -> dict[str, Any]:
 
 
 __all__: Sequence[str] = ["TrialSpec", "identity_row", "run_trial", "make_world", "trial_rngs",
-                          "sim_document"]
+                          "trial_row", "sim_document"]

@@ -240,7 +240,7 @@ class World(PlayerActions):
         walk = self.locomotion
         for guard in self.guards:
             walk.drive(guard, guard.speed)
-        player_speed = self.player_speed * (self.sprint_factor if self.sprinting else 1.0)
+        player_speed = self.player_step_speed()
         if self.player_input is not None:
             vx, vy = self.player_input
             self.player.set_velocity((vx * player_speed, vy * player_speed))
@@ -249,6 +249,10 @@ class World(PlayerActions):
         else:
             walk.drive(self.player, player_speed)
         return player_speed
+
+    def player_step_speed(self) -> float:
+        """The player's speed this step (sprinting or not)."""
+        return self.player_speed * (self.sprint_factor if self.sprinting else 1.0)
 
     def speeds(self, player_speed: float) -> list[float]:
         """The speed each agent walks at this step: the guards', then the player's."""

@@ -183,6 +183,7 @@ ANALYSES: dict[str, str] = {
     "held-out": "headless.analysis.held_out",
     "robustness": "headless.analysis.robustness",
     "paired": "headless.analysis.paired",
+    "engines": "headless.analysis.engines",
 }
 
 

@@ -1,0 +1,354 @@
+"""The batch engine (SPEC §12, ``world.engine = "batch"``): trials of one level and
+abstraction advanced in lockstep, their bodies and senses in arrays.
+
+Each trial of a batch is a :class:`~game.world.World` built by :func:`game.trial.make_world`
+(so spawns, controllers, stimuli and counters are the reference's own), but it is never
+stepped by pymunk. Per physics step the compiled kernels (:mod:`game.batch.kernels`) drive,
+move, settle and sense every body of every live trial at once; whatever they flag — a
+decision, a new waypoint, an arrival, a node entered, damage, a sighting, the AI tick — is
+handed to that trial's world, whose phase methods (:meth:`World.decide`,
+:meth:`World.settle_agent`, :meth:`World.hurt`, :meth:`World.detect`, :meth:`World.end_step`)
+are the rules the reference runs. Before a world's rule runs, the arrays are written into
+its agents (:meth:`Batch.pull`); after, read back (:meth:`Batch.push`). A trial's result
+does not depend on its batch: no value crosses trials, and each keeps its own generators.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Sequence
+from typing import Any
+
+import numpy as np
+
+from navmesh.graph import NodeGraph
+from navmesh.level import cached_level
+
+from ..agents import Agent
+from ..config import Config
+from ..team import SECTIONS
+from ..trial import TrialSpec, make_world, trial_row
+from ..world import World
+from . import kernels
+from .exact import WallGrid
+
+#: trials advanced together at most (memory grows linearly with it)
+MAX_BATCH = 256
+#: the largest graph the batch engine takes (its per-level tables are built per batch)
+MAX_NODES = 200_000
+#: a seeing mask holds one bit per guard
+MAX_GUARDS = 62
+
+
+def uncovered(spec: TrialSpec, config: Config) -> str | None:
+    """None when the batch engine runs ``spec`` as the reference does, else what of it the
+    engine does not cover (a phrase for the one-line refusal)."""
+    if spec.stimuli:
+        return "plugin stimuli (" + ", ".join(spec.stimuli) + ")"
+    for section in SECTIONS:
+        if config[f"{section}.enabled"]:
+            return f"the team switch [{section}] enabled"
+    if config["stimuli.raining"]:
+        return "rain (stimuli.raining)"
+    if int(config["world.guards"]) > MAX_GUARDS:
+        return f"more than {MAX_GUARDS} guards"
+    return None
+
+
+def run_trials(specs: Sequence[TrialSpec]) -> list[dict[str, Any]]:
+    """Run ``specs`` (one level, abstraction and config; at most :data:`MAX_BATCH`) in
+    lockstep; their rows, in order, as :func:`game.trial.run_trial` makes them."""
+    rows: list[dict[str, Any]] = []
+    for start in range(0, len(specs), MAX_BATCH):
+        rows.extend(Batch(specs[start:start + MAX_BATCH]).run())
+    return rows
+
+
+class Batch:
+    """Trials sharing level, abstraction and config, stepped together."""
+
+    def __init__(self, specs: Sequence[TrialSpec]) -> None:
+        if not specs:
+            raise ValueError("a batch needs at least one trial")
+        self.started = time.perf_counter()
+        self.specs = list(specs)
+        first = specs[0]
+        shared = (first.level, first.abstraction, first.settings, first.stimuli)
+        for spec in specs:
+            if (spec.level, spec.abstraction, spec.settings, spec.stimuli) != shared:
+                raise ValueError("a batch's trials share level, abstraction, settings and "
+                                 f"stimuli: {spec.key} differs from {first.key}")
+        config = Config.load(first.settings)
+        problem = uncovered(first, config)
+        if problem is not None:
+            raise ValueError(f'world.engine = "batch" does not cover {problem}; '
+                             'use world.engine = "pymunk"')
+        level = cached_level(first.level)
+        # one config for all: the trials share their settings (Config is read-only)
+        self.worlds = [make_world(spec, config, level=level) for spec in specs]
+        w0 = self.worlds[0]
+        self.graph: NodeGraph = w0.graph
+        if self.graph.n > MAX_NODES:
+            raise ValueError(f'world.engine = "batch" does not cover graphs of more than '
+                             f'{MAX_NODES} nodes ({self.graph.n} here); use world.engine = "pymunk"')
+        self.dt, self.radius = w0.dt, w0.radius
+        self.steps_per_tick, self.steps_per_decision = w0.steps_per_tick, w0.steps_per_decision
+        self.total_steps, self.stuck_timeout = w0.total_steps, w0.stuck_timeout
+        self.attack_range, self.attack_los = w0.attack_range, w0.attack_los
+        self.cos_half_fov = w0.senses.cos_half_fov
+        self.view_scale_at = np.ascontiguousarray(w0.view_scale_at, dtype=np.float64)
+        self.walls = WallGrid.build(level.walls)
+        if self.graph.cell_node is not None:
+            self.cell_node = np.ascontiguousarray(self.graph.cell_node, dtype=np.int64)
+            self.tri_eqs, self.tri_tol = np.zeros((0, 9)), 0.0
+        else:
+            mesh = self.graph.mesh
+            assert mesh is not None
+            self.cell_node = kernels.empty_cells()
+            self.tri_eqs = np.ascontiguousarray(np.asarray(mesh._edge_py, dtype=np.float64))
+            self.tri_tol = float(mesh.tol)
+        self._arrays()
+        for b in range(len(self.worlds)):
+            self.push(b)
+
+    # ------------------------------------------------------------------ state
+    def _arrays(self) -> None:
+        n_trials = len(self.worlds)
+        n_agents = len(self.worlds[0].guards) + 1
+        if any(len(w.guards) + 1 != n_agents for w in self.worlds):
+            raise ValueError("a batch's trials have one number of guards")
+        shape = (n_trials, n_agents)
+        self.pos = np.zeros(shape + (2,))
+        self.vel = np.zeros(shape + (2,))
+        self.cmd = np.zeros(shape + (2,))
+        self.wp = np.zeros(shape + (2,))
+        self.has_wp = np.zeros(shape, dtype=np.bool_)
+        self.cruise_ok = np.zeros(shape, dtype=np.bool_)
+        self.cruise_speed = np.zeros(shape)
+        self.cruise_rem = np.zeros(shape)
+        self.on_track = np.zeros(shape, dtype=np.bool_)
+        self.since = np.zeros(shape)
+        self.node = np.zeros(shape, dtype=np.int64)
+        self.active = np.zeros(shape, dtype=np.bool_)
+        self.speed = np.zeros(shape)
+        self.heading = np.zeros(shape)
+        self.live = np.array([not w.done for w in self.worlds], dtype=np.bool_)
+        self.view_range = np.array([w.view_range for w in self.worlds], dtype=np.float64)
+        self.key = np.full(shape, -2, dtype=np.int64)  # the nodes of the last distance sample
+        self.dist_now = np.zeros(n_trials)
+        self.has_dist = np.zeros(n_trials, dtype=np.bool_)
+        self.dist_sum = np.zeros(n_trials)
+        self.dist_n = np.zeros(n_trials, dtype=np.int64)
+        self.euc_sum = np.zeros(n_trials)
+        self.euc_n = np.zeros(n_trials, dtype=np.int64)
+        self.seeing = np.zeros(n_trials, dtype=np.int64)
+        self.seen = np.array([_bits(w.seen_by) for w in self.worlds], dtype=np.int64)
+        self.attackers = np.array([w.attackers for w in self.worlds], dtype=np.int64)
+        self.key_changed = np.zeros(n_trials, dtype=np.bool_)
+        self.slow = np.zeros(shape, dtype=np.bool_)
+        self.touch = np.zeros(n_trials, dtype=np.bool_)
+        self.step_index = 0
+
+    def agents(self, b: int) -> list[Agent]:
+        """Trial ``b``'s agents in array order: the guards, then the player."""
+        world = self.worlds[b]
+        return [*world.guards, world.player]
+
+    def pull(self, b: int, only: int | None = None) -> None:
+        """Write the arrays into trial ``b``'s world (one agent: ``only``)."""
+        world = self.worlds[b]
+        world.step_index = self.step_index
+        world.attackers = int(self.attackers[b])
+        agents = self.agents(b)
+        pos, on_track, since = self.pos[b].tolist(), self.on_track[b], self.since[b]
+        for a in (range(len(agents)) if only is None else (only,)):
+            agent = agents[a]
+            agent.pos = (pos[a][0], pos[a][1])
+            agent.on_track = bool(on_track[a])
+            agent.since_target = float(since[a])
+            agent.cruise = ((agent.waypoints[0], float(self.cruise_speed[b, a]),
+                             float(self.cruise_rem[b, a])) if self.cruise_ok[b, a] else None)
+            if agent.velocity != (self.cmd[b, a, 0], self.cmd[b, a, 1]):
+                agent.velocity = (float(self.cmd[b, a, 0]), float(self.cmd[b, a, 1]))
+            agent.heading = float(self.heading[b, a])
+
+    def push(self, b: int, only: int | None = None) -> None:
+        """Read trial ``b``'s world back into the arrays (one agent: ``only``)."""
+        world = self.worlds[b]
+        agents = self.agents(b)
+        last = len(agents) - 1
+        for a in (range(len(agents)) if only is None else (only,)):
+            agent = agents[a]
+            self.pos[b, a, 0], self.pos[b, a, 1] = agent.pos
+            if agent.velocity != (self.cmd[b, a, 0], self.cmd[b, a, 1]):  # set_velocity wrote
+                self.cmd[b, a, 0], self.cmd[b, a, 1] = agent.velocity
+                self.vel[b, a, 0], self.vel[b, a, 1] = agent.velocity
+            waypoints = agent.waypoints
+            self.has_wp[b, a] = bool(waypoints)
+            if waypoints:
+                self.wp[b, a, 0], self.wp[b, a, 1] = waypoints[0]
+            cruise = agent.cruise
+            ok = cruise is not None and bool(waypoints) and cruise[0] is waypoints[0]
+            self.cruise_ok[b, a] = ok
+            if ok:
+                assert cruise is not None
+                self.cruise_speed[b, a], self.cruise_rem[b, a] = cruise[1], cruise[2]
+            self.on_track[b, a] = agent.on_track
+            self.since[b, a] = agent.since_target
+            self.node[b, a] = agent.node
+            self.active[b, a] = agent.active
+            self.heading[b, a] = agent.heading
+            self.speed[b, a] = world.player_step_speed() if a == last else agent.speed
+        self.seen[b] = _bits(world.seen_by)
+
+    # ------------------------------------------------------------------ one step
+    def step(self) -> None:
+        """One physics step of every live trial: :meth:`World.step`'s phases in its order."""
+        live, dt = self.live, self.dt
+        if self.step_index % self.steps_per_decision == 0:
+            for b in np.flatnonzero(live):
+                world = self.worlds[b]
+                if any(g.active and g.needs_decision for g in world.guards) or (
+                        world.player_policy is not None and world.player.needs_decision):
+                    self.pull(b)
+                    world.decide()
+                    self.push(b)
+        kernels.drive(live, self.active, self.has_wp, self.wp, self.pos, self.cruise_ok,
+                      self.cruise_speed, self.cruise_rem, self.on_track, self.speed, self.cmd,
+                      self.vel, self.heading, dt)
+        before = self.pos.copy()
+        speeds = self.speed.copy()
+        kernels.move(live, self.pos, self.vel, dt)
+        w = self.walls
+        kernels.touching(live, self.pos, self.radius, w.segs, w.cell_start, w.cell_items,
+                         w.geom, self.touch)
+        if self.touch.any():
+            self._pymunk_step(np.flatnonzero(self.touch), before)
+        self.step_index += 1
+        for b in np.flatnonzero(live & (self.attackers > 0)):
+            self._hurt(b, before)
+        kernels.settle(live, self.pos, before, self.has_wp, self.wp, speeds, dt, self.since,
+                       self.on_track, self.node, self.stuck_timeout, self.radius,
+                       self.cell_node, self.graph.cell_size, self.tri_eqs, self.tri_tol,
+                       self.slow)
+        for b, a in np.argwhere(self.slow & live[:, None]):
+            world = self.worlds[b]
+            self.pull(b, a)
+            world.step_index = self.step_index
+            world.settle_agent(int(a), self.agents(b)[a],
+                               (float(before[b, a, 0]), float(before[b, a, 1])),
+                               float(speeds[b, a]))
+            self.push(b, a)
+        for b in np.flatnonzero(live):
+            if self.worlds[b].sprinting:  # footsteps: the world's rule, where it matters
+                self.pull(b)
+                self.worlds[b].moved((float(before[b, -1, 0]), float(before[b, -1, 1])), True)
+        self._sense()
+        if self.step_index % self.steps_per_tick == 0:
+            for b in np.flatnonzero(live):
+                self.pull(b)
+                self.worlds[b].end_step()
+                self.push(b)
+        elif self.step_index >= self.total_steps:
+            for b in np.flatnonzero(live):
+                self.worlds[b].done = True
+        for b in np.flatnonzero(live):
+            if self.worlds[b].done:
+                live[b] = False
+
+    def _hurt(self, b: int, before: np.ndarray) -> None:
+        """Damage in trial ``b`` as :meth:`World.hurt` deals it, where the reference deals
+        it: after pymunk moved the bodies but before the world read them (every agent's
+        ``pos`` still the step's start); the player's body holds where it moved to, unless
+        a respawn places it elsewhere."""
+        world = self.worlds[b]
+        self.pull(b)
+        agents = self.agents(b)
+        for a, agent in enumerate(agents):
+            agent.pos = (float(before[b, a, 0]), float(before[b, a, 1]))
+        player = world.player
+        player.body.position = (float(self.pos[b, -1, 0]), float(self.pos[b, -1, 1]))
+        before[b, -1] = world.hurt(player.pos)
+        placed = player.body.position
+        self.pos[b, -1] = (placed.x, placed.y)
+        for a, agent in enumerate(agents):
+            agent.pos = (float(self.pos[b, a, 0]), float(self.pos[b, a, 1]))
+        self.push(b)
+
+    def _sense(self) -> None:
+        w = self.walls
+        kernels.sense(self.live, self.pos, self.heading, self.active, self.node, self.view_range,
+                      self.view_scale_at, self.attack_range, self.attack_los, self.cos_half_fov,
+                      w.segs, w.cell_start, w.cell_items, w.geom, self.key, self.dist_now,
+                      self.has_dist, self.dist_sum, self.dist_n, self.euc_sum, self.euc_n,
+                      self.seeing, self.attackers, self.key_changed)
+        live = self.live
+        for b in np.flatnonzero(live & ((self.seeing != 0) | (self.seen != 0))):
+            world = self.worlds[b]
+            world.step_index = self.step_index
+            world.detect(_guards(int(self.seeing[b])))
+            self.seen[b] = _bits(world.seen_by)
+        for b in np.flatnonzero(live & self.key_changed):
+            self._new_distance(b)
+
+    def _new_distance(self, b: int) -> None:
+        """The path distance of trial ``b``'s new nodes, asked of the graph as
+        ``Counters.sample_distance`` asks it, and this step's sample."""
+        p = self.node.shape[1] - 1
+        guards = [int(self.node[b, g]) for g in range(p) if self.active[b, g]]
+        self.key[b, :p] = np.where(self.active[b, :p], self.node[b, :p], -1)
+        self.key[b, p] = self.node[b, p]
+        if guards:
+            self.dist_now[b] = self.graph.nearest_dist_to(guards, int(self.node[b, p]))
+            self.has_dist[b] = True
+            self.dist_sum[b] = float(self.dist_sum[b]) + float(self.dist_now[b])
+            self.dist_n[b] += 1
+        else:
+            self.has_dist[b] = False
+
+    def _pymunk_step(self, trials: np.ndarray, before: np.ndarray) -> None:
+        """Trials with a body at a wall take this step in their own pymunk space, whose
+        solver is the reference's (the kernels move bodies only where nothing touches)."""
+        for b in trials:
+            world = self.worlds[b]
+            agents = self.agents(b)
+            for a, agent in enumerate(agents):
+                agent.body.position = (float(before[b, a, 0]), float(before[b, a, 1]))
+                agent.body.velocity = (float(self.vel[b, a, 0]), float(self.vel[b, a, 1]))
+            world.space.step(self.dt)
+            for a, agent in enumerate(agents):
+                p, v = agent.body.position, agent.body.velocity
+                self.pos[b, a] = (p.x, p.y)
+                self.vel[b, a] = (v.x, v.y)
+            self.contacts += 1
+
+    contacts = 0
+
+    # ------------------------------------------------------------------ the whole run
+    def run(self) -> list[dict[str, Any]]:
+        """Step until every trial has ended; their rows."""
+        while self.live.any():
+            self.step()
+        wall = (time.perf_counter() - self.started) / len(self.worlds)
+        rows = []
+        for b, (spec, world) in enumerate(zip(self.specs, self.worlds, strict=True)):
+            self.pull(b)
+            m = world.m
+            m.dist_sum, m.dist_samples = float(self.dist_sum[b]), int(self.dist_n[b])
+            m.euclid_sum, m.euclid_samples = float(self.euc_sum[b]), int(self.euc_n[b])
+            rows.append(trial_row(spec, world, wall))
+        return rows
+
+
+def _bits(guards: Sequence[int]) -> int:
+    bits = 0
+    for g in guards:
+        bits |= 1 << int(g)
+    return bits
+
+
+def _guards(bits: int) -> tuple[int, ...]:
+    return tuple(g for g in range(bits.bit_length()) if bits >> g & 1)
+
+
+__all__ = ["Batch", "MAX_BATCH", "run_trials", "uncovered"]

@@ -1,0 +1,85 @@
+"""The batch engine (game.batch) equals the pymunk engine trial for trial, whatever its batch.
+
+Small scale here; ``python -m headless.engines`` compares whole sweeps (docs/results.md) and
+``benchmarks/batch.py`` the batch of 256.
+"""
+
+from __future__ import annotations
+
+import concurrent.futures as cf
+from typing import Any
+
+import pytest
+
+from game.batch import MAX_BATCH, Batch, run_trials, uncovered
+from game.config import Config
+from game.trial import TrialSpec, run_trial
+from headless.presets import load_preset
+
+
+def _paper(level: str, abstraction: str, seeds: int = 1) -> list[TrialSpec]:
+    return [s for s in load_preset("paper").with_seeds(seeds).specs()
+            if s.level == level and s.abstraction == abstraction]
+
+
+def _result(row: dict[str, Any]) -> tuple[Any, ...]:
+    return row["key"], row["metrics"], row["visits"], row["attacks"], row["config_hash"]
+
+
+@pytest.mark.parametrize("level, abstraction", [("arkham", "grid"), ("miami", "partition")])
+def test_every_paper_trial_of_a_level_equals_the_reference(level: str, abstraction: str) -> None:
+    # all five guard modes x both players x both scenarios of seed 0: 20 trials in one batch
+    specs = _paper(level, abstraction)
+    assert len(specs) == 20
+    batch = [_result(r) for r in run_trials(specs)]
+    reference = [_result(run_trial(s)) for s in specs]
+    assert batch == reference
+
+
+def test_a_trial_does_not_depend_on_its_batch_or_the_order() -> None:
+    specs = _paper("maze", "grid")[:7]
+    alone = _result(run_trials(specs[3:4])[0])
+    in_seven = [_result(r) for r in run_trials(specs)]
+    reversed_ = [_result(r) for r in run_trials(specs[::-1])][::-1]
+    assert in_seven[3] == alone
+    assert reversed_ == in_seven
+
+
+def test_another_process_gives_the_same_rows() -> None:
+    specs = _paper("dishonored", "grid")[:3]
+    here = [_result(r) for r in run_trials(specs)]
+    with cf.ProcessPoolExecutor(1) as pool:
+        there = [_result(r) for r in pool.submit(run_trials, specs).result()]
+    assert there == here
+
+
+def test_a_batch_ends_each_trial_at_its_own_time() -> None:
+    # capture trials end at the capture; the batch goes on with the others
+    specs = [s for s in _paper("maze", "grid", seeds=2) if s.scenario == "capture"]
+    batch = Batch(specs)
+    steps = 0
+    while batch.live.any():
+        batch.step()
+        steps += 1
+    ends = {w.step_index for w in batch.worlds}
+    assert max(ends) == steps and len(ends) > 1
+
+
+def test_trials_of_different_levels_or_settings_are_not_one_batch() -> None:
+    a, b = _paper("maze", "grid")[0], _paper("arkham", "grid")[0]
+    with pytest.raises(ValueError, match="share level"):
+        Batch([a, b])
+    with pytest.raises(ValueError, match="at least one"):
+        Batch([])
+    assert MAX_BATCH == 256
+
+
+def test_what_it_does_not_cover_is_named() -> None:
+    spec = TrialSpec("maze")
+    assert uncovered(spec, Config.load()) is None
+    assert "awareness" in str(uncovered(spec, Config.load({"awareness.enabled": True})))
+    assert "raining" in str(uncovered(spec, Config.load({"stimuli.raining": True})))
+    plugin = TrialSpec("maze", stimuli=("examples/siren.py:Siren",))
+    assert "plugin stimuli" in str(uncovered(plugin, Config.load()))
+    with pytest.raises(ValueError, match='does not cover the team switch'):
+        Batch([TrialSpec("maze", overrides=(("alert.enabled", True),))])
