@@ -41,7 +41,8 @@ HASH_NEUTRAL_PREFIX = "metrics."
 #: keys that choose how a trial is computed, never what it gives (SPEC §12: the engines give
 #: equal results trial for trial): out of :meth:`Config.hash` at any value and out of
 #: :attr:`game.trial.TrialSpec.key`, so a stored trial resumes or re-runs on either engine
-IDENTITY_NEUTRAL: frozenset[str] = frozenset({"world.engine"})
+ENGINE_KEY = "world.engine"
+IDENTITY_NEUTRAL: frozenset[str] = frozenset({ENGINE_KEY})
 
 
 def _flatten(table: Mapping[str, Any], prefix: str = "") -> dict[str, Any]:

@@ -206,6 +206,7 @@ def sim_document(row: Mapping[str, Any]) -> dict[str, Any]:
         "config_hash": row["config_hash"],
         "config": row["config"],
         **({"stimuli": list(row["stimuli"])} if row.get("stimuli") else {}),
+        **({"engine": row["engine"]} if "engine" in row else {}),
         "metrics": row["metrics"],
     }
 
