@@ -38,6 +38,12 @@ DEFAULTS_PATH = Path(__file__).with_name("defaults.toml")
 #: :meth:`Config.hash` while at their default
 HASH_NEUTRAL_PREFIX = "metrics."
 
+#: keys that choose how a trial is computed, never what it gives (SPEC §12: the engines give
+#: equal results trial for trial): out of :meth:`Config.hash` at any value and out of
+#: :attr:`game.trial.TrialSpec.key`, so a stored trial resumes or re-runs on either engine
+ENGINE_KEY = "world.engine"
+IDENTITY_NEUTRAL: frozenset[str] = frozenset({ENGINE_KEY})
+
 
 def _flatten(table: Mapping[str, Any], prefix: str = "") -> dict[str, Any]:
     flat: dict[str, Any] = {}
@@ -190,10 +196,13 @@ class Config:
         """A short stable digest of every value: equal configs, equal hashes, any process.
 
         A ``[metrics]`` key (what is measured, never what happens) at its default is left
-        out, so a store written before the section existed keeps its hash and resumes.
+        out, so a store written before the section existed keeps its hash and resumes; an
+        :data:`IDENTITY_NEUTRAL` key (``world.engine``: how, not what) is left out at any
+        value, so the same design has one hash on either engine.
         """
         defaults = _default_values()
         values = {k: v for k, v in self._values.items()
-                  if not (k.startswith(HASH_NEUTRAL_PREFIX) and defaults.get(k) == v)}
+                  if k not in IDENTITY_NEUTRAL
+                  and not (k.startswith(HASH_NEUTRAL_PREFIX) and defaults.get(k) == v)}
         canonical = json.dumps(values, sort_keys=True, separators=(",", ":"))
         return hashlib.sha256(canonical.encode()).hexdigest()[:16]

@@ -48,7 +48,7 @@ if TYPE_CHECKING:
     from navmesh.level import Level
 
 __all__ = [
-    "RESPAWN_RULES", "SEED", "SPAWN_RULES", "bound_of", "check_level", "check_sections",
+    "ENGINES", "RESPAWN_RULES", "SEED", "SPAWN_RULES", "bound_of", "check_level", "check_sections",
     "markdown_table", "parameter_defaults", "parameter_sections", "registered_params",
     "scenario_speeds",
 ]
@@ -61,6 +61,12 @@ RESPAWN_RULES = ("farthest", "random", "stay")
 the start rule's farthest hidden node, a hidden node drawn uniformly, or where it stands
 (``stay``: HP restored, no teleport; the paper's trial runs "regardless of the player's
 health status")."""
+
+ENGINES = ("pymunk", "batch")
+"""``world.engine`` (SPEC §12): what advances a headless trial. ``pymunk``: the reference,
+one :class:`~game.world.World` per trial; ``batch``: the trials of one level and abstraction
+advanced in lockstep over arrays (:mod:`game.batch`). Both give the same rows trial for trial,
+so the engine is no part of a trial's identity (``game.config.IDENTITY_NEUTRAL``)."""
 
 SEED = Range(0, 2**63 - 1, integer=True)
 """A trial's ``seed`` and a preset's ``root_seed``: whole numbers that fit the store's
@@ -97,6 +103,7 @@ WORLD: Mapping[str, Bound] = {
     "attack_range": NON_NEGATIVE,
     "attack_needs_line_of_sight": FLAG,
     "stuck_timeout": POSITIVE,
+    "engine": OneOf(ENGINES),
 }
 """``[world]``: the keys the world reads itself."""
 

@@ -21,7 +21,7 @@ from ai.stimuli import load_stimulus
 from ai.view import GuardAI, PlayerPolicy
 from navmesh.level import Level, cached_level
 
-from .config import Config
+from .config import IDENTITY_NEUTRAL, Config
 from .schema import scenario_speeds
 from .trace import attach_trace
 from .world import Generators, World
@@ -56,15 +56,26 @@ class TrialSpec:
 
     @property
     def key(self) -> str:
-        """A unique, human-readable key of this trial (used by the results store)."""
-        extra = ",".join(f"{k}={v}" for k, v in self.overrides)
+        """A unique, human-readable key of this trial (used by the results store).
+
+        A setting that changes how the trial is computed, never its result
+        (:data:`game.config.IDENTITY_NEUTRAL`: ``world.engine``), is no part of it, so a
+        stored trial resumes and re-runs on either engine.
+        """
+        overrides, factors = _identity(self.overrides), _identity(self.factors)
+        extra = ",".join(f"{k}={v}" for k, v in overrides)
         parts = [self.level, self.abstraction, self.guards, self.player, self.scenario,
                  str(self.seed), str(self.root_seed), extra]
         if self.stimuli:  # only then, so the keys of trials without plugins do not change
             parts.append("stimuli=" + "+".join(self.stimuli))
-        if self.factors:  # likewise: a design without factors keeps today's keys
-            parts.append("factors=" + ",".join(f"{k}={v}" for k, v in self.factors))
+        if factors:  # likewise: a design without factors keeps today's keys
+            parts.append("factors=" + ",".join(f"{k}={v}" for k, v in factors))
         return "/".join(parts)
+
+
+def _identity(settings: tuple[tuple[str, Any], ...]) -> tuple[tuple[str, Any], ...]:
+    """``settings`` without the keys that are no part of a trial's identity."""
+    return tuple((k, v) for k, v in settings if k not in IDENTITY_NEUTRAL)
 
 
 def trial_rngs(spec: TrialSpec, level_name: str) -> Generators:
@@ -78,7 +89,7 @@ def trial_rngs(spec: TrialSpec, level_name: str) -> Generators:
     """
     base = [spec.root_seed, _tag(level_name), _tag(spec.abstraction), spec.seed]
     who = [_tag(spec.guards), _tag(spec.player), _tag(spec.scenario)]
-    who += [_tag(f"{k}={v!r}") for k, v in spec.factors]
+    who += [_tag(f"{k}={v!r}") for k, v in _identity(spec.factors)]
     seqs = [
         np.random.SeedSequence(base + [_tag("spawn")]),
         np.random.SeedSequence(base + who + [_tag("guards")]),
@@ -153,7 +164,9 @@ def run_trial(
     spec: TrialSpec, trace: IO[str] | None = None, explain: bool = False, *,
     world: World | None = None,
 ) -> dict[str, Any]:
-    """Run one trial to its end and return its row: identity, config hash, metrics, heatmaps.
+    """Run one trial to its end and return its row: identity, config hash, metrics, heatmaps,
+    and ``engine``, the engine that ran it (here always ``"pymunk"``, the reference; the
+    batch engine's rows, :func:`game.batch.run_trials`, say ``"batch"``).
 
     With ``trace`` every AI tick (and t = 0) is written as one JSON line; with ``explain``
     those lines also carry the first guard's last decision explained (PF only). ``world``
@@ -172,10 +185,10 @@ def run_trial(
 
 
 def trial_row(spec: TrialSpec, world: World, wall_time: float,
-              metrics: dict[str, Any] | None = None) -> dict[str, Any]:
+              metrics: dict[str, Any] | None = None, engine: str = "pymunk") -> dict[str, Any]:
     """The row of a trial whose ``world`` has ended (either engine makes it here):
-    identity, config hash, metrics (``world.metrics()`` unless given), heatmaps and the
-    seconds it took."""
+    identity, config hash, metrics (``world.metrics()`` unless given), heatmaps, the
+    seconds it took and the engine that ran it."""
     config = world.config
     return {
         **identity_row(spec, world.level.name),
@@ -185,6 +198,7 @@ def trial_row(spec: TrialSpec, world: World, wall_time: float,
         "visits": world.m.visits.tolist(),
         "attacks": [round(a, 6) for a in world.m.attacks.tolist()],
         "wall_time": wall_time,
+        "engine": engine,
     }
 
 
@@ -200,6 +214,7 @@ def sim_document(row: Mapping[str, Any]) -> dict[str, Any]:
         "config_hash": row["config_hash"],
         "config": row["config"],
         **({"stimuli": list(row["stimuli"])} if row.get("stimuli") else {}),
+        **({"engine": row["engine"]} if "engine" in row else {}),
         "metrics": row["metrics"],
     }
 

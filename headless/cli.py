@@ -401,6 +401,7 @@ def build_parser() -> argparse.ArgumentParser:
                    help="run seeds 0..N-1 instead of the preset's (more seeds grow a stored "
                         "design: only the missing trials run)")
     add_config(p)
+    add_set(p)  # after --config's, as the preset's [set] is: e.g. --set world.engine=batch
     p.set_defaults(func=_cmd_run)
 
     p = command("tune", "search a parameter space with Optuna (resumable study)")

@@ -2,10 +2,14 @@
 
 The unit of work is :func:`run_batch` — a few :class:`~game.trial.TrialSpec` in, their rows
 out — a pure, top-level, picklable function, so every ``concurrent.futures.Executor`` runs
-it alike (Mesa's batch runner). A failing trial never raises: it becomes a row with an
-``error`` text, so only the machinery itself (a dead worker, a cluster that cannot import
-the project) makes a task fail. To add an executor, return any ``concurrent.futures``
-executor from a function here and pick it in :func:`headless.sweep.run_sweep`.
+it alike (Mesa's batch runner); on the batch engine (``world.engine = "batch"``) it is
+:func:`run_engine_batch`, up to ``game.batch.MAX_BATCH`` trials of one level, abstraction,
+``[set]`` and factor combination advanced together. A failing trial never raises: it
+becomes a row with an ``error`` text (on the batch engine a batch that raises makes every
+one of its trials such a row), so only the machinery itself (a dead worker, a cluster that
+cannot import the project) makes a task fail. To add an executor, return any
+``concurrent.futures`` executor from a function here and pick it in
+:func:`headless.sweep.run_sweep`.
 """
 
 from __future__ import annotations
@@ -27,8 +31,12 @@ from .errors import SweepError, UserError
 
 __all__ = [
     "MAX_WORKERS_PER_CPU", "InlineExecutor", "check_workers", "connect_dask", "process_pool",
-    "run_batch", "run_one", "shutdown", "terminate",
+    "run_batch", "run_engine_batch", "run_one", "shutdown", "terminate",
 ]
+
+
+def _error_text(error: BaseException) -> str:
+    return f"{type(error).__name__}: {error}\n{traceback.format_exc(limit=-8)}"[:8000]
 
 
 def run_one(spec: TrialSpec, level_name: str | None = None) -> dict[str, Any]:
@@ -38,8 +46,7 @@ def run_one(spec: TrialSpec, level_name: str | None = None) -> dict[str, Any]:
     try:
         return run_trial(spec)
     except Exception as error:
-        text = f"{type(error).__name__}: {error}\n{traceback.format_exc(limit=-8)}"
-        return {**identity_row(spec, level_name), "error": text[:8000]}
+        return {**identity_row(spec, level_name), "error": _error_text(error)}
 
 
 def run_batch(specs: Sequence[TrialSpec], level_names: Mapping[str, str] | None = None
@@ -48,6 +55,32 @@ def run_batch(specs: Sequence[TrialSpec], level_names: Mapping[str, str] | None 
     ``level_names``: the level's name of each level reference, for the rows of failures."""
     names = level_names or {}
     return [run_one(spec, names.get(spec.level)) for spec in specs]
+
+
+def run_engine_batch(specs: Sequence[TrialSpec], level_names: Mapping[str, str] | None = None
+                     ) -> list[dict[str, Any]]:
+    """Run trials that share level, abstraction, overrides and factors on the batch engine
+    (:func:`game.batch.run_trials`: one row per spec, in order, each a
+    :func:`~game.trial.run_trial` row); top-level and picklable like :func:`run_batch`.
+
+    A batch that raises, or answers with rows that are not its specs' (another count,
+    another key), becomes an error row for each of its specs (``engine`` batch), so a
+    rerun retries them, as it retries a failed trial.
+    """
+    names = level_names or {}
+    try:
+        from game.batch import run_trials
+
+        rows = list(run_trials(specs))
+        keys = [row.get("key") for row in rows]
+        if keys != [spec.key for spec in specs]:
+            raise RuntimeError(f"the batch engine answered {len(rows)} rows for {len(specs)} "
+                               "trials, or not in their order")
+        return rows
+    except Exception as error:
+        text = _error_text(error)
+        return [{**identity_row(spec, names.get(spec.level)), "error": text, "engine": "batch"}
+                for spec in specs]
 
 
 class InlineExecutor(cf.Executor):

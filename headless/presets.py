@@ -21,6 +21,7 @@ from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
+from game.config import ENGINE_KEY
 from game.config_file import flatten
 from game.trial import TrialSpec
 from navmesh.files import FileRefused, read_regular
@@ -69,6 +70,9 @@ class Preset:
     stimuli: tuple[str, ...] = ()
     #: ``(key, levels)`` of every factor, sorted by key (the design crosses all of them)
     factors: tuple[tuple[str, tuple[Any, ...]], ...] = ()
+    #: ``world.engine`` the sweep runs the trials on (SPEC §12); no part of the design, the
+    #: overrides, the trials' keys or the config hash: the engines give equal results
+    engine: str = "pymunk"
 
     @property
     def n_trials(self) -> int:
@@ -327,7 +331,7 @@ def parse_preset(
     resolved against ``base`` (the preset file's folder); ``extra`` overrides the ``[set]``."""
     from ai import GUARD_MODES, PLAYER_POLICIES, guard_mode, player_policy
     from game.budget import check_design_steps
-    from game.config import Config
+    from game.config import IDENTITY_NEUTRAL, Config
     from game.errors import ConfigError
     from game.schema import SEED, check_level
     from game.scenarios import SCENARIOS
@@ -368,9 +372,21 @@ def parse_preset(
     except ConfigError as error:
         raise _fail(src, "set", str(error)) from None
     # The values as the config coerced them (10 -> 10.0 for a float key), so equal settings
-    # written differently give equal trial keys.
-    overrides = tuple((key, config[key]) for key in sorted(flat))
+    # written differently give equal trial keys. The engine is how, not what: it stays out
+    # of the trials' overrides and the design, so a store resumes on either engine.
+    overrides = tuple((key, config[key]) for key in sorted(flat) if key not in IDENTITY_NEUTRAL)
     factors = _factors(data, src, flat)
+    engine = str(config[ENGINE_KEY])
+    for key, levels in factors:
+        if key == ENGINE_KEY:
+            if len(levels) > 1:
+                raise _fail(src, f"factors.{key}", "the engines give equal results trial for "
+                            "trial, so a factor over them would run every trial twice under "
+                            "one key; name one engine (in [set])")
+            engine = str(levels[0])
+    factors = tuple((key, levels) for key, levels in factors if key not in IDENTITY_NEUTRAL)
+    if engine != config[ENGINE_KEY]:
+        config = config.with_overrides({ENGINE_KEY: engine})
     n_trials *= math.prod(len(levels) for _, levels in factors)
     if n_trials > MAX_TRIALS:
         raise _fail(src, "factors", f"the design has {n_trials} trials, more than the limit of "
@@ -426,7 +442,7 @@ def parse_preset(
         scenarios=tuple(scenarios), seeds=seeds, root_seed=root_seed, overrides=overrides,
         description=description, config_hash=config.hash(), config=config.as_dict(),
         stimuli=stimuli,
-        factors=factors,
+        factors=factors, engine=engine,
     )
 
 

@@ -8,6 +8,9 @@
   ``attacks`` lists (zlib-compressed JSON, ``json.loads(zlib.decompress(blob))``), the error
   text (``NULL`` on success), the wall time and when it finished;
 * the trial's factor values (``factors``, JSON; ``{}`` without factors, SPEC §10);
+* ``engine``, the engine that ran the trial (``world.engine``, SPEC §12: ``pymunk`` or
+  ``batch``; no part of the key, the engines giving equal results; ``NULL`` in the rows of a
+  store written before the column, which opening it for writing adds);
 * ``meta`` — key/value text: the preset (its TOML text and its expanded design as JSON),
   the config hash and ``level_digests`` (the SHA-256 of every level file, by level
   reference), so ``stealth report`` knows the design and a resumed sweep can check that it
@@ -78,7 +81,8 @@ CREATE TABLE IF NOT EXISTS trials (
     error TEXT,
     wall_time REAL,
     finished_at TEXT NOT NULL,
-    factors TEXT
+    factors TEXT,
+    engine TEXT
 );
 CREATE TABLE IF NOT EXISTS meta (
     key TEXT PRIMARY KEY,
@@ -93,7 +97,7 @@ _JSON_IDENTITY: tuple[str, ...] = ("overrides", "factors")
 _HEAD: tuple[str, ...] = ("key", "level", "level_ref", "abstraction", "guards", "player",
                           "scenario", "seed", "root_seed", "overrides", "config_hash")
 _TAIL: tuple[str, ...] = ("extra_metrics", "visits", "attacks", "error", "wall_time",
-                          "finished_at", "factors")
+                          "finished_at", "factors", "engine")
 
 
 def _upsert(columns: tuple[str, ...]) -> str:
@@ -187,6 +191,8 @@ class ResultStore:
                 self.db.execute(f"ALTER TABLE trials ADD COLUMN {m.name} {m.sql_type}")
         if "factors" not in present:  # a store written before designs had factors
             self.db.execute("ALTER TABLE trials ADD COLUMN factors TEXT")
+        if "engine" not in present:  # a store written before rows said their engine
+            self.db.execute("ALTER TABLE trials ADD COLUMN engine TEXT")
 
     # ------------------------------------------------------------------ context manager
     def __enter__(self) -> ResultStore:
@@ -257,6 +263,7 @@ class ResultStore:
             "error": row.get("error"),
             "wall_time": row.get("wall_time"),
             "finished_at": _now(),
+            "engine": row.get("engine"),
         }
         with self.db:
             self.db.execute(_upsert(self.columns), [values[c] for c in self.columns])

@@ -9,6 +9,12 @@ with fewer seeds), skips the trials already in the store, and maps
 process is the only writer of the store and commits each trial as soon as it arrives, so
 a killed sweep is resumed by running the same command again; :mod:`headless.progress`
 draws the bar.
+
+On the batch engine (``world.engine = "batch"``, :mod:`headless.engines`) every pending
+trial is first checked to be one the engine covers (one line and exit 2 if not, nothing
+written), and the task is :func:`~headless.executors.run_engine_batch` over
+:func:`batch_tasks`: up to ``game.batch.MAX_BATCH`` trials that share level, abstraction,
+overrides and factors, spread over the workers.
 """
 
 from __future__ import annotations
@@ -27,12 +33,14 @@ from datetime import datetime, timezone
 from pathlib import Path
 from typing import IO, Any
 
+from game.config import parse_overrides
 from game.config_file import read_config_file
 from game.trial import TrialSpec
 from navmesh.level import zone_kinds
 
 from .outputs.dirlock import DirectoryLock
 from .errors import SweepError
+from .engines import BATCH, check_covered
 from .estimate import MEASURED_DURATION, duration_text, estimate_seconds
 from .executors import (
     InlineExecutor,
@@ -40,6 +48,7 @@ from .executors import (
     connect_dask,
     process_pool,
     run_batch,
+    run_engine_batch,
     shutdown,
     terminate,
 )
@@ -49,7 +58,7 @@ from .presets import Preset, load_preset
 from .progress import Progress
 from .store import STORE_NAME, ResultStore
 
-__all__ = ["SweepResult", "cmd_run", "run_sweep"]
+__all__ = ["SweepResult", "batch_tasks", "cmd_run", "run_sweep"]
 
 _MAX_BATCH = 8  # trials per task: ~0.3-0.5 s of work, pickling overhead negligible
 
@@ -87,6 +96,52 @@ class SweepResult:
 def _batches(specs: Sequence[TrialSpec], size: int) -> Iterator[list[TrialSpec]]:
     for i in range(0, len(specs), size):
         yield list(specs[i:i + size])
+
+
+def _batch_group(spec: TrialSpec) -> tuple[Any, ...]:
+    """What the trials of one batch share (game.batch.run_trials): level, abstraction,
+    overrides, factors (and root seed and stimuli, which every trial of a design shares)."""
+    return (spec.level, spec.abstraction, spec.overrides, spec.factors, spec.root_seed,
+            spec.stimuli)
+
+
+def batch_tasks(specs: Sequence[TrialSpec], workers: int, max_batch: int
+                ) -> list[list[TrialSpec]]:
+    """The batch engine's tasks: ``specs`` grouped by level, abstraction, overrides and
+    factors (seeds, guard modes, player policies and scenarios vary inside a group), each
+    group cut into near-equal tasks of at most ``max_batch`` trials, and smaller ones when
+    there are fewer trials than ``max_batch`` x ``workers``, so every worker gets work.
+
+    Every spec is in exactly one task, in the sweep's order within its group; the tasks
+    take the groups in turn (the first task of each, then the second, ...), so an
+    interrupted sweep has run every group's first seeds.
+
+    >>> specs = [TrialSpec(level, seed=seed) for seed in range(3) for level in ("a", "b")]
+    >>> [[(s.level, s.seed) for s in task] for task in batch_tasks(specs, 1, 2)]
+    [[('a', 0), ('a', 1)], [('b', 0), ('b', 1)], [('a', 2)], [('b', 2)]]
+    """
+    if max_batch < 1 or workers < 1:
+        raise ValueError(f"batch_tasks: workers {workers} and max_batch {max_batch} must be >= 1")
+    groups: dict[tuple[Any, ...], list[TrialSpec]] = {}
+    for spec in specs:
+        groups.setdefault(_batch_group(spec), []).append(spec)
+    size = max(1, min(max_batch, math.ceil(len(specs) / workers)))
+    cut = []
+    for group in groups.values():
+        per = math.ceil(len(group) / math.ceil(len(group) / size))  # near-equal parts
+        cut.append([group[i:i + per] for i in range(0, len(group), per)])
+    return [parts[i] for i in range(max((len(p) for p in cut), default=0))
+            for parts in cut if i < len(parts)]
+
+
+def _pending(specs: list[TrialSpec], store_path: Path) -> list[TrialSpec]:
+    """The ``specs`` not yet finished in the store at ``store_path`` (read only: nothing is
+    written), all of them when there is no store yet."""
+    if not store_path.is_file():
+        return specs
+    with ResultStore(store_path, readonly=True) as store:
+        done = store.done_keys() if store.meta() else set()
+    return [s for s in specs if s.key not in done]
 
 
 def level_digests(preset: Preset) -> dict[str, str]:
@@ -168,6 +223,9 @@ def run_sweep(
     store_path = out / STORE_NAME
     digests = level_digests(preset)
     _check_store(store_path, preset, digests)
+    batch = preset.engine == BATCH
+    if batch:  # before anything is written: a trial the engine does not cover is refused
+        check_covered(_pending(preset.specs(), store_path))
     client: Any = None
     executor: cf.Executor | None = None
     lock: DirectoryLock | None = None
@@ -190,7 +248,8 @@ def run_sweep(
                          f"({len(preset.levels)} levels x {len(preset.abstractions)} "
                          f"abstractions x {len(preset.guards)} guard modes x "
                          f"{len(preset.players)} player policies x {len(preset.scenarios)} "
-                         f"scenarios{factors} x {len(preset.seeds)} seeds) -> {out}\n")
+                         f"scenarios{factors} x {len(preset.seeds)} seeds) -> {out}"
+                         f"{' (engine batch)' if batch else ''}\n")
         store = ResultStore(store_path)
         now = datetime.now(timezone.utc).isoformat(timespec="seconds")
         old_design = store.get_meta("design")
@@ -224,12 +283,20 @@ def run_sweep(
         if executor is None:
             executor = process_pool(workers)
         inline = isinstance(executor, InlineExecutor)
-        size = 1 if inline else max(1, min(_MAX_BATCH, math.ceil(len(todo) / (parallelism * 8))))
         in_flight = 1 if inline else 2 * parallelism
+        task: Callable[..., list[dict[str, Any]]] = run_batch
+        if batch:
+            from game.batch import MAX_BATCH
+
+            task, tasks = run_engine_batch, iter(batch_tasks(todo, parallelism, MAX_BATCH))
+        else:
+            size = 1 if inline else max(1, min(_MAX_BATCH,
+                                               math.ceil(len(todo) / (parallelism * 8))))
+            tasks = _batches(todo, size)
         bar = Progress(len(todo), stream, enabled=progress)
         started = time.monotonic()
         try:
-            _drive(executor, _batches(todo, size), in_flight, store, preset, result, bar)
+            _drive(executor, tasks, in_flight, store, preset, result, bar, task)
         finally:
             result.elapsed = time.monotonic() - started
             bar.close()
@@ -282,8 +349,10 @@ class _TaskError(Exception):
 
 
 def _drive(executor: cf.Executor, batches: Iterator[list[TrialSpec]], in_flight: int,
-           store: ResultStore, preset: Preset, result: SweepResult, bar: Progress) -> None:
-    """Keep at most ``in_flight`` tasks submitted; commit every result as it arrives."""
+           store: ResultStore, preset: Preset, result: SweepResult, bar: Progress,
+           task: Callable[..., list[dict[str, Any]]] = run_batch) -> None:
+    """Keep at most ``in_flight`` tasks submitted (``task`` over each batch: ``run_batch``,
+    or ``run_engine_batch`` on the batch engine); commit every result as it arrives."""
     pending: dict[cf.Future[Any], list[TrialSpec]] = {}
     names = dict(zip(preset.levels, preset.level_names))  # for the rows of failed trials
 
@@ -291,7 +360,7 @@ def _drive(executor: cf.Executor, batches: Iterator[list[TrialSpec]], in_flight:
         pending.pop(future)
         error = future.exception()
         if error is not None:
-            # run_batch never raises for a failing trial, so this is the machinery: a
+            # a task never raises for a failing trial, so this is the machinery: a
             # worker process died, the cluster cannot import the project, pickling failed.
             raise _TaskError(error)
         _record(future.result(), store, result, bar)
@@ -304,7 +373,7 @@ def _drive(executor: cf.Executor, batches: Iterator[list[TrialSpec]], in_flight:
                 if batch is None:
                     exhausted = True
                     break
-                pending[executor.submit(run_batch, batch, names)] = batch
+                pending[executor.submit(task, batch, names)] = batch
             if not pending:
                 break
             done, _ = cf.wait(list(pending), timeout=1.0, return_when=cf.FIRST_COMPLETED)
@@ -357,6 +426,8 @@ def _resume_command(args: argparse.Namespace, out: Path) -> str:
         words += ["--seeds", str(args.seeds)]
     if args.config:
         words += ["--config", args.config]
+    for item in getattr(args, "set", None) or ():
+        words += ["--set", item]
     if args.workers:
         words += ["--workers", str(args.workers)]
     if args.scheduler:
@@ -373,8 +444,9 @@ def cmd_run(args: argparse.Namespace) -> int:
     """
     if args.workers is not None:
         check_workers(args.workers)
-    extra = read_config_file(args.config) if args.config else None
-    preset = load_preset(args.preset, extra)
+    extra = {**(read_config_file(args.config) if args.config else {}),
+             **dict(parse_overrides(getattr(args, "set", None) or ()))}
+    preset = load_preset(args.preset, extra or None)
     if args.seeds is not None:
         preset = preset.with_seeds(args.seeds)
     out = Path(args.out) if args.out else output_path("results", preset.name)

@@ -78,7 +78,7 @@ class Batch:
             if (spec.level, spec.abstraction, spec.settings, spec.stimuli) != shared:
                 raise ValueError("a batch's trials share level, abstraction, settings and "
                                  f"stimuli: {spec.key} differs from {first.key}")
-        config = Config.load(first.settings)
+        config = Config.load({**first.settings, "world.engine": "batch"})  # rows say so
         problem = uncovered(first, config)
         if problem is not None:
             raise ValueError(f'world.engine = "batch" does not cover {problem}; '
@@ -336,7 +336,7 @@ class Batch:
             m = world.m
             m.dist_sum, m.dist_samples = float(self.dist_sum[b]), int(self.dist_n[b])
             m.euclid_sum, m.euclid_samples = float(self.euc_sum[b]), int(self.euc_n[b])
-            rows.append(trial_row(spec, world, wall))
+            rows.append(trial_row(spec, world, wall, engine="batch"))
         return rows
 
 

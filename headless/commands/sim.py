@@ -1,6 +1,9 @@
 """``stealth sim``: one trial, its metrics printed (SPEC §9), optionally its trace.
 
-The level and the config are loaded and checked once, here, and handed to the trial.
+The level and the config are loaded and checked once, here, and handed to the trial. With
+``--set world.engine=batch`` the trial runs on the batch engine
+(``game.batch.run_trials([spec])[0]``, the same row), refused in one line when that engine
+does not cover it or a trace is asked for (it writes none).
 """
 
 from __future__ import annotations
@@ -11,11 +14,12 @@ from collections.abc import Mapping, Sequence
 from typing import Any
 
 from ai.stimuli import load_stimulus
-from game.config import Config, parse_overrides
+from game.config import ENGINE_KEY, Config, parse_overrides
 from game.config_file import read_config_file
 from game.trial import TrialSpec, make_world, run_trial, sim_document
 from navmesh.level import load_level, resolve_level_path
 
+from ..engines import BATCH, check_covered, refusal
 from ..outputs.clobber import open_output, plugin_files
 from .failure import UsageError
 from .levels import emit_json
@@ -54,8 +58,17 @@ def cmd_sim(args: argparse.Namespace) -> int:
         stimuli=tuple(args.stimulus),
     )
     config = Config.load(spec.settings)  # every key and value checked: one-line ConfigError
+    batch = config[ENGINE_KEY] == BATCH
+    if batch and (args.trace or args.explain):
+        raise refusal(f"{'--trace' if args.trace else '--explain'} (it writes no traces)")
+    if batch:
+        check_covered([spec])
     world = make_world(spec, config, level=level)  # checks the config against the level
-    if args.trace:
+    if batch:  # the world above only checked the config: the batch engine runs the trial
+        from game.batch import run_trials
+
+        row = run_trials([spec])[0]
+    elif args.trace:
         handle = open_output("--trace", args.trace, [resolve_level_path(args.level), args.config,
                                                      *plugin_files(args.stimulus)])
         try:
