@@ -83,3 +83,32 @@ def test_what_it_does_not_cover_is_named() -> None:
     assert "plugin stimuli" in str(uncovered(plugin, Config.load()))
     with pytest.raises(ValueError, match='does not cover the team switch'):
         Batch([TrialSpec("maze", overrides=(("alert.enabled", True),))])
+
+
+def test_a_body_driven_into_a_wall_moves_as_pymunk_moves_it() -> None:
+    # the kernels hand a trial with a body at a wall to its own pymunk space (its solver)
+    from collections import deque
+
+    from game.trial import make_world
+
+    spec = _paper("maze", "grid")[0]
+    reference, batch = make_world(spec, Config.load(spec.settings)), Batch([spec])
+    guard = reference.guards[0]
+    x, y = guard.pos
+    level = reference.level
+    # walk straight at the nearest wall, through it, at an angle
+    (ax, ay), (bx, by) = min(level.walls, key=lambda w: min(
+        (w[0][0] - x) ** 2 + (w[0][1] - y) ** 2, (w[1][0] - x) ** 2 + (w[1][1] - y) ** 2))
+    target = (ax + 0.3 * (bx - ax) + 3.0 * (ax - x), ay + 0.3 * (by - ay) + 3.0 * (ay - y))
+    for world in (reference, batch.worlds[0]):
+        world.guards[0].waypoints = deque([target])
+        world.guards[0].target = world.guards[0].node
+    batch.push(0)
+    contacts = 0
+    for _ in range(60):
+        reference.step()
+        batch.step()
+        batch.pull(0)
+        assert batch.worlds[0].guards[0].pos == reference.guards[0].pos
+        contacts += int(batch.touch[0])
+    assert contacts > 0

@@ -147,6 +147,7 @@ class Batch:
         self.key_changed = np.zeros(n_trials, dtype=np.bool_)
         self.slow = np.zeros(shape, dtype=np.bool_)
         self.touch = np.zeros(n_trials, dtype=np.bool_)
+        self.held = np.zeros(n_trials, dtype=np.int64)  # steps left in pymunk's hands
         self.step_index = 0
 
     def agents(self, b: int) -> list[Agent]:
@@ -206,7 +207,7 @@ class Batch:
         """One physics step of every live trial: :meth:`World.step`'s phases in its order."""
         live, dt = self.live, self.dt
         if self.step_index % self.steps_per_decision == 0:
-            for b in np.flatnonzero(live):
+            for b in np.flatnonzero(live).tolist():
                 world = self.worlds[b]
                 if any(g.active and g.needs_decision for g in world.guards) or (
                         world.player_policy is not None and world.player.needs_decision):
@@ -222,16 +223,22 @@ class Batch:
         w = self.walls
         kernels.touching(live, self.pos, self.radius, w.segs, w.cell_start, w.cell_items,
                          w.geom, self.touch)
-        if self.touch.any():
-            self._pymunk_step(np.flatnonzero(self.touch), before)
+        # pymunk's solver answers a contact with a velocity and a bias it applies over the
+        # next steps (cpBody's v_bias, its arbiters kept 3 steps): such a trial takes this
+        # step and the next three in its own space
+        self.held[self.touch] = 4
+        held = live & (self.held > 0)
+        if held.any():
+            self._pymunk_step(np.flatnonzero(held), before)
+            self.held[held] -= 1
         self.step_index += 1
-        for b in np.flatnonzero(live & (self.attackers > 0)):
+        for b in np.flatnonzero(live & (self.attackers > 0)).tolist():
             self._hurt(b, before)
         kernels.settle(live, self.pos, before, self.has_wp, self.wp, speeds, dt, self.since,
                        self.on_track, self.node, self.stuck_timeout, self.radius,
                        self.cell_node, self.graph.cell_size, self.tri_eqs, self.tri_tol,
                        self.slow)
-        for b, a in np.argwhere(self.slow & live[:, None]):
+        for b, a in np.argwhere(self.slow & live[:, None]).tolist():
             world = self.worlds[b]
             self.pull(b, a)
             world.step_index = self.step_index
@@ -239,20 +246,20 @@ class Batch:
                                (float(before[b, a, 0]), float(before[b, a, 1])),
                                float(speeds[b, a]))
             self.push(b, a)
-        for b in np.flatnonzero(live):
+        for b in np.flatnonzero(live).tolist():
             if self.worlds[b].sprinting:  # footsteps: the world's rule, where it matters
                 self.pull(b)
                 self.worlds[b].moved((float(before[b, -1, 0]), float(before[b, -1, 1])), True)
         self._sense()
         if self.step_index % self.steps_per_tick == 0:
-            for b in np.flatnonzero(live):
+            for b in np.flatnonzero(live).tolist():
                 self.pull(b)
                 self.worlds[b].end_step()
                 self.push(b)
         elif self.step_index >= self.total_steps:
-            for b in np.flatnonzero(live):
+            for b in np.flatnonzero(live).tolist():
                 self.worlds[b].done = True
-        for b in np.flatnonzero(live):
+        for b in np.flatnonzero(live).tolist():
             if self.worlds[b].done:
                 live[b] = False
 
@@ -283,12 +290,12 @@ class Batch:
                       self.has_dist, self.dist_sum, self.dist_n, self.euc_sum, self.euc_n,
                       self.seeing, self.attackers, self.key_changed)
         live = self.live
-        for b in np.flatnonzero(live & ((self.seeing != 0) | (self.seen != 0))):
+        for b in np.flatnonzero(live & ((self.seeing != 0) | (self.seen != 0))).tolist():
             world = self.worlds[b]
             world.step_index = self.step_index
             world.detect(_guards(int(self.seeing[b])))
             self.seen[b] = _bits(world.seen_by)
-        for b in np.flatnonzero(live & self.key_changed):
+        for b in np.flatnonzero(live & self.key_changed).tolist():
             self._new_distance(b)
 
     def _new_distance(self, b: int) -> None:
@@ -309,7 +316,7 @@ class Batch:
     def _pymunk_step(self, trials: np.ndarray, before: np.ndarray) -> None:
         """Trials with a body at a wall take this step in their own pymunk space, whose
         solver is the reference's (the kernels move bodies only where nothing touches)."""
-        for b in trials:
+        for b in trials.tolist():
             world = self.worlds[b]
             agents = self.agents(b)
             for a, agent in enumerate(agents):
