@@ -1,0 +1,1 @@
+"""The batched engine: many trials stepped together in compiled loops."""
