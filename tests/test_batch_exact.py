@@ -20,13 +20,13 @@ from numba import njit
 
 from game.agents import WALL_QUERY, build_space
 from game.batch.exact import TOUCH_EPS, WallGrid, clear_line, py_hypot, touches_wall
-from navmesh.level import cached_level
+from navmesh.level import Level, cached_level
 
 LEVELS = ("arkham", "dishonored", "maze", "miami", "tlou")
 
 
 @njit(error_model="numpy")
-def _hypots(x, y):  # type: ignore[no-untyped-def]
+def _hypots(x: np.ndarray, y: np.ndarray) -> np.ndarray:
     out = np.empty(x.shape[0])
     for i in range(x.shape[0]):
         out[i] = py_hypot(x[i], y[i])
@@ -34,7 +34,8 @@ def _hypots(x, y):  # type: ignore[no-untyped-def]
 
 
 @njit(error_model="numpy")
-def _clear_lines(segs, cell_start, cell_items, geom, q):  # type: ignore[no-untyped-def]
+def _clear_lines(segs: np.ndarray, cell_start: np.ndarray, cell_items: np.ndarray,
+                 geom: np.ndarray, q: np.ndarray) -> np.ndarray:
     out = np.empty(q.shape[0], dtype=np.bool_)
     for i in range(q.shape[0]):
         out[i] = clear_line(segs, cell_start, cell_items, geom, q[i, 0], q[i, 1], q[i, 2], q[i, 3])
@@ -42,7 +43,8 @@ def _clear_lines(segs, cell_start, cell_items, geom, q):  # type: ignore[no-unty
 
 
 @njit(error_model="numpy")
-def _touches(segs, cell_start, cell_items, geom, p, r):  # type: ignore[no-untyped-def]
+def _touches(segs: np.ndarray, cell_start: np.ndarray, cell_items: np.ndarray, geom: np.ndarray,
+             p: np.ndarray, r: np.ndarray) -> np.ndarray:
     out = np.empty(p.shape[0], dtype=np.bool_)
     for i in range(p.shape[0]):
         out[i] = touches_wall(segs, cell_start, cell_items, geom, p[i, 0], p[i, 1], r[i])
@@ -98,7 +100,7 @@ def _reference(space: pymunk.Space, q: np.ndarray) -> np.ndarray:
                         for a, b, c, d in q.tolist()), dtype=bool, count=len(q))
 
 
-def _walkable_points(level, rng: np.random.Generator, n: int) -> np.ndarray:  # type: ignore[no-untyped-def]
+def _walkable_points(level: Level, rng: np.random.Generator, n: int) -> np.ndarray:
     x0, y0, x1, y1 = level.walkable.bounds
     out = np.empty((0, 2))
     while len(out) < n:
@@ -107,7 +109,7 @@ def _walkable_points(level, rng: np.random.Generator, n: int) -> np.ndarray:  # 
     return out[:n]
 
 
-def _random_segments(level, rng: np.random.Generator, n: int) -> np.ndarray:  # type: ignore[no-untyped-def]
+def _random_segments(level: Level, rng: np.random.Generator, n: int) -> np.ndarray:
     a = _walkable_points(level, rng, n)
     ang = rng.uniform(0, 2 * math.pi, n)
     length = rng.uniform(0, 10, n)
@@ -115,7 +117,8 @@ def _random_segments(level, rng: np.random.Generator, n: int) -> np.ndarray:  # 
     return np.hstack([a, b])
 
 
-def _adversarial_segments(segs: np.ndarray, rng: np.random.Generator, bounds: tuple) -> np.ndarray:  # type: ignore[type-arg]
+def _adversarial_segments(segs: np.ndarray, rng: np.random.Generator,
+                          bounds: tuple[float, float, float, float]) -> np.ndarray:
     """Sight lines meeting the walls' endpoints, lines and interiors exactly."""
     x0, y0, x1, y1 = bounds
     ends = np.unique(np.vstack([segs[:, :2], segs[:, 2:]]), axis=0)
@@ -134,12 +137,13 @@ def _adversarial_segments(segs: np.ndarray, rng: np.random.Generator, bounds: tu
     out.append(np.hstack([e - k * d, e + m * d]))
     # along walls: collinear with their line, inside, across and beyond their ends
     w = pick(segs, n)
+    start, span = w[:, :2], w[:, 2:] - w[:, :2]
     s, t = rng.integers(-8, 25, (2, n, 1)) / 16.0
-    out.append(np.hstack([w[:, :2] + s * (w[:, 2:] - w[:, :2]), w[:, :2] + t * (w[:, 2:] - w[:, :2])]))
+    out.append(np.hstack([start + s * span, start + t * span]))
     su, tu = rng.uniform(-0.5, 1.5, (2, n, 1))
-    out.append(np.hstack([w[:, :2] + su * (w[:, 2:] - w[:, :2]), w[:, :2] + tu * (w[:, 2:] - w[:, :2])]))
+    out.append(np.hstack([start + su * span, start + tu * span]))
     # starting on a wall, going anywhere near
-    on = w[:, :2] + s * (w[:, 2:] - w[:, :2])
+    on = start + s * span
     out.append(np.hstack([on, on + rng.uniform(-3, 3, (n, 2))]))
     out.append(np.hstack([on + rng.uniform(-3, 3, (n, 2)), on]))
     out.append(np.hstack([on, on + rng.integers(-6, 7, (n, 2)) / 2.0]))
@@ -205,13 +209,42 @@ def test_clear_line_matches_pymunk_on_random_walls(count: int) -> None:
     assert len(bad) == 0, [(q_all[i].tolist(), bool(theirs[i])) for i in bad[:5]]
 
 
+def test_clear_line_edge_cases() -> None:
+    """Chipmunk's tie rules, each against pymunk: a hit must come before alpha 1 (a long
+    line crossing one lone wall by one ulp is clear), a line ending on a wall is clear, one
+    starting on it (or on a zero-length wall's point) is blocked."""
+    up = math.nextafter(5.0, 9.0)
+    wall = ((0.0, 5.0), (10.0, 5.0))
+    far = ((50.0, 50.0), (51.0, 51.0))
+    dot = ((2.0, 2.0), (2.0, 2.0))
+    cases = [
+        ([wall], (3.0, -100.0, 3.0, up), True),  # alpha rounds to 1
+        ([wall, far], (3.0, -100.0, 3.0, up), True),  # and the box query enters at 1
+        ([wall], (3.0, -1.0, 3.0, up), False),
+        ([wall, far], (3.0, 0.0, 3.0, 5.0), True),  # ends on the wall
+        ([wall, far], (3.0, 5.0, 3.0, 0.0), False),  # starts on it
+        ([wall, far], (10.0, 5.0, 12.0, 7.0), False),  # starts on its endpoint
+        ([wall, far], (0.0, 7.0, 0.0, 3.0), False),  # through its endpoint
+        ([wall, far], (-3.0, 5.0, 13.0, 5.0), True),  # along it
+        ([dot, far], (2.0, 2.0, 3.0, 3.0), False),  # from a zero-length wall's point
+        ([dot, far], (1.0, 1.0, 3.0, 3.0), True),  # through it
+        ([dot, far], (2.0, 2.0, 2.0, 2.0), False),
+        ([], (0.0, 0.0, 1.0, 1.0), True),
+    ]
+    for walls, (ax, ay, bx, by), clear in cases:
+        grid = WallGrid.build(walls)
+        space = _space_of(grid.segs)
+        assert (space.segment_query_first((ax, ay), (bx, by), 0.0, WALL_QUERY) is None) == clear
+        assert clear_line(*grid.arrays, ax, ay, bx, by) == clear, (walls, (ax, ay, bx, by))
+
+
 @pytest.mark.parametrize("name", ["maze", "dishonored"])
 def test_touches_wall_is_conservative_and_tight(name: str) -> None:
     level = cached_level(name)
     rng = np.random.default_rng(7)
     grid = WallGrid.build(level.walls)
     segs = grid.segs
-    n = 50_000
+    n = 20_000
     x0, y0, x1, y1 = level.walkable.bounds
     p = rng.uniform((x0 - 2, y0 - 2), (x1 + 2, y1 + 2), (n, 2))
     # many right at the contact distance of some wall
@@ -219,14 +252,16 @@ def test_touches_wall_is_conservative_and_tight(name: str) -> None:
     along = w[:, :2] + rng.uniform(-0.2, 1.2, (n // 2, 1)) * (w[:, 2:] - w[:, :2])
     r = rng.uniform(0.05, 1.5, n)
     ang = rng.uniform(0, 2 * math.pi, n // 2)
-    p[: n // 2] = along + np.stack([np.cos(ang), np.sin(ang)], 1) * (r[: n // 2, None]
-                                                                       + rng.normal(0, 1e-7, (n // 2, 1)))
+    gap = r[: n // 2, None] + rng.normal(0, 1e-7, (n // 2, 1))
+    p[: n // 2] = along + np.stack([np.cos(ang), np.sin(ang)], 1) * gap
     ours = _touches(*grid.arrays, p, r)
     # brute force over every wall (vectorised point-segment distance)
     a, e = segs[None, :, :2], segs[None, :, 2:] - segs[None, :, :2]
-    rel = p[:, None, :] - a
-    t = np.clip((rel * e).sum(-1) / (e * e).sum(-1), 0.0, 1.0)
-    dist = np.linalg.norm(rel - t[..., None] * e, axis=-1).min(axis=1)
+    dist = np.empty(n)
+    for lo in range(0, n, 4000):
+        rel = p[lo:lo + 4000, None, :] - a
+        t = np.clip((rel * e).sum(-1) / (e * e).sum(-1), 0.0, 1.0)
+        dist[lo:lo + 4000] = np.linalg.norm(rel - t[..., None] * e, axis=-1).min(axis=1)
     assert not (~ours & (dist < r)).any()  # never misses a contact pymunk could make
     assert not (ours & (dist > r + 2 * TOUCH_EPS)).any()  # and stays tight
     assert np.array_equal(ours, dist <= r + TOUCH_EPS) or (

@@ -335,9 +335,10 @@ class WallGrid:
         return self.segs, self.cell_start, self.cell_items, self.geom
 
     @classmethod
-    def build(cls, walls: Sequence[tuple[tuple[float, float], tuple[float, float]]],
+    def build(cls, walls: Sequence[tuple[tuple[float, float], tuple[float, float]]] | np.ndarray,
               cell: float = 2.0) -> WallGrid:
-        """Bucket ``walls`` (``((ax, ay), (bx, by))`` each) in cells of side ``cell``."""
+        """Bucket ``walls`` (``((ax, ay), (bx, by))`` each, or a level's ``(m, 2, 2)`` array)
+        in cells of side ``cell``."""
         segs = np.array([[float(a[0]), float(a[1]), float(b[0]), float(b[1])]
                          for a, b in walls], dtype=np.float64).reshape(-1, 4)
         nwalls = len(segs)
@@ -363,8 +364,8 @@ class WallGrid:
             i1 = min(int(math.floor((max(ax, bx) + m - x0) / cell)), ncx - 1)
             j0 = max(int(math.floor((min(ay, by) - m - y0) / cell)), 0)
             j1 = min(int(math.floor((max(ay, by) + m - y0) / cell)), ncy - 1)
-            ii, jj = np.meshgrid(np.arange(i0, i1 + 1), np.arange(j0, j1 + 1))
-            ii, jj = ii.ravel(), jj.ravel()
+            gi, gj = np.meshgrid(np.arange(i0, i1 + 1), np.arange(j0, j1 + 1))
+            ii, jj = gi.ravel(), gj.ravel()
             cx = x0 + (ii + 0.5) * cell
             cy = y0 + (jj + 0.5) * cell
             ex, ey = bx - ax, by - ay
