@@ -217,6 +217,7 @@ def test_clear_line_edge_cases() -> None:
     wall = ((0.0, 5.0), (10.0, 5.0))
     far = ((50.0, 50.0), (51.0, 51.0))
     dot = ((2.0, 2.0), (2.0, 2.0))
+    post = ((0.0, 0.0), (0.0, 1.0))
     cases = [
         ([wall], (3.0, -100.0, 3.0, up), True),  # alpha rounds to 1
         ([wall, far], (3.0, -100.0, 3.0, up), True),  # and the box query enters at 1
@@ -230,6 +231,12 @@ def test_clear_line_edge_cases() -> None:
         ([dot, far], (1.0, 1.0, 3.0, 3.0), True),  # through it
         ([dot, far], (2.0, 2.0, 2.0, 2.0), False),
         ([], (0.0, 0.0, 1.0, 1.0), True),
+        # a start 1e-170 off a wall is on it (its distance squared underflows) ...
+        ([post], (1e-170, 0.5, -5.0, 0.5), False),
+        ([post], (1e-170, 0.5, 5.0, 0.5), False),
+        ([post, far], (1e-170, 0.5, 5.0, 0.5), True),  # ... unless the box query culls it
+        ([post, far], (2.0**-1000, 0.5, 2.0**80, 0.5), False),  # which a -0 quotient passes
+        ([post, far], (2.0**-1000, 0.5, 2.0**60, 0.5), True),
     ]
     for walls, (ax, ay, bx, by), clear in cases:
         grid = WallGrid.build(walls)

@@ -29,8 +29,10 @@ from numba import njit
 _T27 = 134217729.0
 #: CPFLOAT_MIN (DBL_MIN): cpvnormalize divides by length + DBL_MIN
 _DBL_MIN = 2.2250738585072014e-308
+#: 2**-1000: a gap this small against a segment's extent may underflow in cpBBSegmentQuery
+_TINY = 2.0**-1000
 #: how far around its own box a wall is bucketed (covers the queries' rounding)
-GRID_MARGIN = 1.0
+GRID_MARGIN = 0.25
 #: slack of :func:`touches_wall` over the body radius
 TOUCH_EPS = 1e-6
 
@@ -174,6 +176,13 @@ def _wall_hits(segs: np.ndarray, w: int, root_leaf: bool,
         else:
             bb = wby
             bt = way
+        # boxes apart by more than the segment's extent times 2**-1000: the box query
+        # fails too (it can pass for a closer box, when a quotient underflows to -0)
+        sx = abs(bx - ax) * _TINY
+        sy = abs(by - ay) * _TINY
+        if (min(ax, bx) - br > sx or bl - max(ax, bx) > sx
+                or min(ay, by) - bt > sy or bb - max(ay, by) > sy):
+            return False
         if not (_bb_segment_query(bl - 0.0, bb - 0.0, br + 0.0, bt + 0.0, ax, ay, bx, by) < 1.0):
             return False
     # cpSegmentShapePointQuery of a (cpClosetPointOnSegment); a hit at distance <= 0
@@ -221,13 +230,12 @@ def _wall_hits(segs: np.ndarray, w: int, root_leaf: bool,
 
 @njit(cache=True, error_model="numpy", inline="always")
 def _cell_range(lo: float, hi: float, origin: float, cell: float, n: int) -> tuple[int, int]:
-    """The clamped cell indices covering [lo, hi] along one axis."""
-    i0 = int(math.floor((lo - origin) / cell))
-    i1 = int(math.floor((hi - origin) / cell))
-    if i0 < 0:
-        i0 = 0
-    if i1 > n - 1:
-        i1 = n - 1
+    """The clamped cell indices covering [lo, hi] along one axis (clamped as floats: a huge
+    coordinate must not overflow the integer)."""
+    f0 = math.floor((lo - origin) / cell)
+    f1 = math.floor((hi - origin) / cell)
+    i0 = 0 if not f0 > 0.0 else (n - 1 if f0 > n - 1 else int(f0))
+    i1 = n - 1 if not f1 < n - 1 else (0 if f1 < 0.0 else int(f1))
     return i0, i1
 
 
