@@ -237,12 +237,27 @@ def test_clear_line_edge_cases() -> None:
         ([post, far], (1e-170, 0.5, 5.0, 0.5), True),  # ... unless the box query culls it
         ([post, far], (2.0**-1000, 0.5, 2.0**80, 0.5), False),  # which a -0 quotient passes
         ([post, far], (2.0**-1000, 0.5, 2.0**60, 0.5), True),
+        ([post, far], (-1e20, 0.5, 1e20, 0.5), False),  # far beyond the grid, both ends
+        ([post, far], (-1e20, -1e20, 1e20, 1e20), False),  # through its endpoint
+        ([post, far], (-1e20, 2.0, 1e20, 2.0), True),
+        ([post, far], (-1e20, 2.0, -1e20, 0.5), True),
     ]
     for walls, (ax, ay, bx, by), clear in cases:
         grid = WallGrid.build(walls)
         space = _space_of(grid.segs)
         assert (space.segment_query_first((ax, ay), (bx, by), 0.0, WALL_QUERY) is None) == clear
         assert clear_line(*grid.arrays, ax, ay, bx, by) == clear, (walls, (ax, ay, bx, by))
+
+
+def test_clear_line_does_not_depend_on_the_cell_size() -> None:
+    rng = np.random.default_rng(21)
+    segs = rng.uniform(0, 20, (80, 4))
+    walls = [((a, b), (c, d)) for a, b, c, d in segs.tolist()]
+    q = np.vstack([rng.uniform(-2, 22, (20_000, 4)),
+                   _adversarial_segments(segs, rng, (0.0, 0.0, 20.0, 20.0))])
+    answers = [_clear_lines(*WallGrid.build(walls, cell=cell).arrays, q)
+               for cell in (0.3, 1.0, 2.0, 7.0, 50.0)]
+    assert all(np.array_equal(answers[0], other) for other in answers[1:])
 
 
 @pytest.mark.parametrize("name", ["maze", "dishonored"])

@@ -31,7 +31,8 @@ _T27 = 134217729.0
 _DBL_MIN = 2.2250738585072014e-308
 #: 2**-1000: a gap this small against a segment's extent may underflow in cpBBSegmentQuery
 _TINY = 2.0**-1000
-#: how far around its own box a wall is bucketed (covers the queries' rounding)
+#: how far around its own box a wall is bucketed (covers the cell arithmetic's rounding and
+#: a box query passing a box this close through a quotient underflowing to -0)
 GRID_MARGIN = 0.25
 #: slack of :func:`touches_wall` over the body radius
 TOUCH_EPS = 1e-6
@@ -250,7 +251,8 @@ def clear_line(segs: np.ndarray, cell_start: np.ndarray, cell_items: np.ndarray,
     nwalls = segs.shape[0]
     if nwalls == 0:
         return True
-    root_leaf = nwalls == 1
+    if nwalls == 1:  # the tree's root is the wall's leaf: no box culling
+        return not _wall_hits(segs, 0, True, ax, ay, bx, by)
     x0 = geom[0]
     y0 = geom[1]
     cell = geom[2]
@@ -268,7 +270,7 @@ def clear_line(segs: np.ndarray, cell_start: np.ndarray, cell_items: np.ndarray,
         for i in range(i0, i1 + 1):
             c = j * ncx + i
             for k in range(cell_start[c], cell_start[c + 1]):
-                if _wall_hits(segs, cell_items[k], root_leaf, ax, ay, bx, by):
+                if _wall_hits(segs, cell_items[k], False, ax, ay, bx, by):
                     return False
     return True
 
@@ -327,10 +329,10 @@ class WallGrid:
     """A level's walls bucketed in square cells, as arrays the compiled queries take.
 
     ``segs`` (W, 4): each wall's ``ax, ay, bx, by``; ``cell_start`` (ncells + 1,) and
-    ``cell_items`` (K,): CSR lists of the walls passing within :data:`GRID_MARGIN` of each
-    cell (cell ``j * ncx + i`` covers ``[x0 + i*cell, x0 + (i+1)*cell)`` by the same in y);
-    ``geom``: ``[x0, y0, cell, ncx, ncy]``. Memory grows with the walls' length, never with
-    walls x walls or cells x walls.
+    ``cell_items`` (K,): CSR lists of the walls whose box, grown by :data:`GRID_MARGIN`,
+    meets each cell (cell ``j * ncx + i`` covers ``[x0 + i*cell, x0 + (i+1)*cell)`` by the
+    same in y); ``geom``: ``[x0, y0, cell, ncx, ncy]``. Memory grows with the walls' boxes
+    (a level's walls are axis-aligned: their length), never walls x walls or cells x walls.
     """
 
     def __init__(self, segs: np.ndarray, cell_start: np.ndarray, cell_items: np.ndarray,
@@ -363,8 +365,8 @@ class WallGrid:
         cell = max(float(cell), math.sqrt((x1 - x0) * (y1 - y0) / cap))
         ncx = int(math.floor((x1 - x0) / cell)) + 1
         ncy = int(math.floor((y1 - y0) / cell)) + 1
-        # a wall goes in every cell whose centre lies within margin + half a diagonal of it
-        reach = m + cell * math.sqrt(0.5)
+        # a wall goes in every cell its box (plus the margin) meets: chipmunk tests a wall
+        # only when the sight line enters its box, so one of those cells lies on the line
         cells: list[np.ndarray] = []
         owners: list[np.ndarray] = []
         for w, (ax, ay, bx, by) in enumerate(segs):
@@ -373,15 +375,8 @@ class WallGrid:
             j0 = max(int(math.floor((min(ay, by) - m - y0) / cell)), 0)
             j1 = min(int(math.floor((max(ay, by) + m - y0) / cell)), ncy - 1)
             gi, gj = np.meshgrid(np.arange(i0, i1 + 1), np.arange(j0, j1 + 1))
-            ii, jj = gi.ravel(), gj.ravel()
-            cx = x0 + (ii + 0.5) * cell
-            cy = y0 + (jj + 0.5) * cell
-            ex, ey = bx - ax, by - ay
-            ll = ex * ex + ey * ey
-            t = np.clip(((cx - ax) * ex + (cy - ay) * ey) / ll, 0.0, 1.0) if ll > 0 else 0.0
-            near = np.hypot(cx - (ax + ex * t), cy - (ay + ey * t)) <= reach
-            cells.append((jj * ncx + ii)[near])
-            owners.append(np.full(int(near.sum()), w, dtype=np.int64))
+            cells.append((gj * ncx + gi).ravel())
+            owners.append(np.full(gi.size, w, dtype=np.int64))
         flat_cells = np.concatenate(cells).astype(np.int64)
         flat_walls = np.concatenate(owners)
         order = np.lexsort((flat_walls, flat_cells))
