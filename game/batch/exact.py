@@ -14,7 +14,7 @@ query has its own rounding and tie rules). This module holds the two ports:
   the walls bucketed in a :class:`WallGrid`. :func:`touches_wall` is the conservative
   contact test that decides when a body must go back to pymunk.
 
-All inputs are finite floats.
+The wall queries take finite coordinates; :func:`py_hypot` takes any float.
 """
 
 from __future__ import annotations
