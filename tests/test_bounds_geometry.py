@@ -199,6 +199,7 @@ def test_a_stuck_agent_replans_another_way() -> None:
         before = agent.pos
         walk.drive(agent, agent.speed)
         walk.space.step(0.05)
+        agent.sync()  # the world reads the body, then settles (World.step)
         walk.settle(agent, before, agent.speed, 3.0)
         agent.node = graph.node_near(*agent.pos, agent.node)
         crossed = crossed or agent.pos[0] > 3.05 + RADIUS
