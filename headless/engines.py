@@ -25,8 +25,9 @@ BATCH = "batch"
 
 def refusal(what: str) -> UserError:
     """The one-line error for a trial the batch engine does not cover (``what`` names it)."""
-    return UserError(f'{ENGINE_KEY} = "{BATCH}" does not cover {what}; '
-                     f'use {ENGINE_KEY} = "{PYMUNK}"')
+    from game.batch import refusal_text
+
+    return UserError(refusal_text(what))
 
 
 def check_covered(specs: Iterable[TrialSpec]) -> None:

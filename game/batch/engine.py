@@ -21,7 +21,7 @@ from typing import Any
 
 import numpy as np
 
-from navmesh.graph import NodeGraph
+from navmesh.graph import NodeGraph, graph_for
 from navmesh.level import cached_level
 
 from ..agents import Agent
@@ -40,9 +40,14 @@ MAX_NODES = 200_000
 MAX_GUARDS = 62
 
 
+def refusal_text(what: str) -> str:
+    """The one line refusing a trial the batch engine does not cover (``what`` names it)."""
+    return f'world.engine = "batch" does not cover {what}; use world.engine = "pymunk"'
+
+
 def uncovered(spec: TrialSpec, config: Config) -> str | None:
     """None when the batch engine runs ``spec`` as the reference does, else what of it the
-    engine does not cover (a phrase for the one-line refusal)."""
+    engine does not cover (a phrase for :func:`refusal_text`)."""
     if spec.stimuli:
         return "plugin stimuli (" + ", ".join(spec.stimuli) + ")"
     for section in SECTIONS:
@@ -52,6 +57,10 @@ def uncovered(spec: TrialSpec, config: Config) -> str | None:
         return "rain (stimuli.raining)"
     if int(config["world.guards"]) > MAX_GUARDS:
         return f"more than {MAX_GUARDS} guards"
+    nodes = graph_for(cached_level(spec.level), spec.abstraction,
+                      float(config["world.agent_radius"])).n  # cached: the trials build it too
+    if nodes > MAX_NODES:
+        return f"graphs of more than {MAX_NODES} nodes ({spec.level}: {nodes})"
     return None
 
 
@@ -81,16 +90,12 @@ class Batch:
         config = Config.load({**first.settings, "world.engine": "batch"})  # rows say so
         problem = uncovered(first, config)
         if problem is not None:
-            raise ValueError(f'world.engine = "batch" does not cover {problem}; '
-                             'use world.engine = "pymunk"')
+            raise ValueError(refusal_text(problem))
         level = cached_level(first.level)
         # one config for all: the trials share their settings (Config is read-only)
         self.worlds = [make_world(spec, config, level=level) for spec in specs]
         w0 = self.worlds[0]
         self.graph: NodeGraph = w0.graph
-        if self.graph.n > MAX_NODES:
-            raise ValueError(f'world.engine = "batch" does not cover graphs of more than '
-                             f'{MAX_NODES} nodes ({self.graph.n} here); use world.engine = "pymunk"')
         self.dt, self.radius = w0.dt, w0.radius
         self.steps_per_tick, self.steps_per_decision = w0.steps_per_tick, w0.steps_per_decision
         self.total_steps, self.stuck_timeout = w0.total_steps, w0.stuck_timeout
@@ -148,6 +153,10 @@ class Batch:
         self.slow = np.zeros(shape, dtype=np.bool_)
         self.touch = np.zeros(n_trials, dtype=np.bool_)
         self.held = np.zeros(n_trials, dtype=np.int64)  # steps left in pymunk's hands
+        self.ended = ~self.live  # trials whose world is done: not stepped after this step
+        self.sprinting = np.zeros(n_trials, dtype=np.bool_)
+        self.has_policy = np.array([w.player_policy is not None for w in self.worlds],
+                                   dtype=np.bool_)
         self.step_index = 0
 
     def agents(self, b: int) -> list[Agent]:
@@ -201,19 +210,20 @@ class Batch:
             self.heading[b, a] = agent.heading
             self.speed[b, a] = world.player_step_speed() if a == last else agent.speed
         self.seen[b] = _bits(world.seen_by)
+        self.sprinting[b] = world.sprinting
 
     # ------------------------------------------------------------------ one step
     def step(self) -> None:
         """One physics step of every live trial: :meth:`World.step`'s phases in its order."""
         live, dt = self.live, self.dt
-        if self.step_index % self.steps_per_decision == 0:
-            for b in np.flatnonzero(live).tolist():
-                world = self.worlds[b]
-                if any(g.active and g.needs_decision for g in world.guards) or (
-                        world.player_policy is not None and world.player.needs_decision):
-                    self.pull(b)
-                    world.decide()
-                    self.push(b)
+        if self.step_index % self.steps_per_decision == 0:  # World.decide's askers
+            idle = ~self.has_wp
+            idle[:, :-1] &= self.active[:, :-1]
+            idle[:, -1] &= self.has_policy
+            for b in np.flatnonzero(live & idle.any(axis=1)).tolist():
+                self.pull(b)
+                self.worlds[b].decide()
+                self.push(b)
         kernels.drive(live, self.active, self.has_wp, self.wp, self.pos, self.cruise_ok,
                       self.cruise_speed, self.cruise_rem, self.on_track, self.speed, self.cmd,
                       self.vel, self.heading, dt)
@@ -246,22 +256,21 @@ class Batch:
                                (float(before[b, a, 0]), float(before[b, a, 1])),
                                float(speeds[b, a]))
             self.push(b, a)
-        for b in np.flatnonzero(live).tolist():
-            if self.worlds[b].sprinting:  # footsteps: the world's rule, where it matters
-                self.pull(b)
-                self.worlds[b].moved((float(before[b, -1, 0]), float(before[b, -1, 1])), True)
+        for b in np.flatnonzero(live & self.sprinting).tolist():  # footsteps: the world's rule
+            self.pull(b)
+            self.worlds[b].moved((float(before[b, -1, 0]), float(before[b, -1, 1])), True)
         self._sense()
         if self.step_index % self.steps_per_tick == 0:
             for b in np.flatnonzero(live).tolist():
                 self.pull(b)
                 self.worlds[b].end_step()
                 self.push(b)
+                self.ended[b] = self.worlds[b].done
         elif self.step_index >= self.total_steps:
             for b in np.flatnonzero(live).tolist():
                 self.worlds[b].done = True
-        for b in np.flatnonzero(live).tolist():
-            if self.worlds[b].done:
-                live[b] = False
+            self.ended[live] = True
+        live[self.ended] = False
 
     def _hurt(self, b: int, before: np.ndarray) -> None:
         """Damage in trial ``b`` as :meth:`World.hurt` deals it, where the reference deals
@@ -276,6 +285,7 @@ class Batch:
         player = world.player
         player.body.position = (float(self.pos[b, -1, 0]), float(self.pos[b, -1, 1]))
         before[b, -1] = world.hurt(player.pos)
+        self.ended[b] = world.done  # a capture that ends the trial: after this step
         placed = player.body.position
         self.pos[b, -1] = (placed.x, placed.y)
         for a, agent in enumerate(agents):
@@ -327,9 +337,7 @@ class Batch:
                 p, v = agent.body.position, agent.body.velocity
                 self.pos[b, a] = (p.x, p.y)
                 self.vel[b, a] = (v.x, v.y)
-            self.contacts += 1
 
-    contacts = 0
 
     # ------------------------------------------------------------------ the whole run
     def run(self) -> list[dict[str, Any]]:
@@ -358,4 +366,4 @@ def _guards(bits: int) -> tuple[int, ...]:
     return tuple(g for g in range(bits.bit_length()) if bits >> g & 1)
 
 
-__all__ = ["Batch", "MAX_BATCH", "run_trials", "uncovered"]
+__all__ = ["Batch", "MAX_BATCH", "refusal_text", "run_trials", "uncovered"]
