@@ -30,7 +30,7 @@ from ..team import SECTIONS
 from ..trial import TrialSpec, make_world, trial_row
 from ..world import World
 from . import kernels
-from .exact import WallGrid
+from ..exact import WallGrid
 
 #: trials advanced together at most (memory grows linearly with it)
 MAX_BATCH = 256

@@ -11,36 +11,16 @@ player last.
 
 from __future__ import annotations
 
-import hashlib
 import math
-from pathlib import Path
 
 import numpy as np
 from numba import njit
 
-from . import exact
-from .exact import clear_line, py_hypot, touches_wall
+from .. import exact
+from ..exact import clear_line, py_hypot, touches_wall
 
 
-def _forget_stale_kernels() -> None:
-    """numba's on-disk cache of this module is keyed on this file alone, yet its kernels
-    inline :mod:`.exact`: when that file changed since they were cached, drop them."""
-    here = Path(__file__)
-    cache = here.parent / "__pycache__"
-    stamp = hashlib.sha256(Path(exact.__file__).read_bytes()).hexdigest()[:16]
-    mark = cache / f"{here.stem}.exact-{stamp}"
-    if mark.exists():
-        return
-    try:
-        for old in cache.glob(f"{here.stem}.*"):
-            old.unlink()
-        cache.mkdir(exist_ok=True)
-        mark.touch()
-    except OSError:  # a read-only install: its cache was made with the files it ships
-        pass
-
-
-_forget_stale_kernels()
+exact.forget_stale_cache(__file__)
 
 #: the reference's tolerances (game.agents.ARRIVE_EPS, game.senses.RANGE_EPS)
 ARRIVE_EPS = 1e-3

@@ -1,4 +1,4 @@
-"""game.batch.exact against what it ports: CPython's math.hypot and pymunk's segment query.
+"""game.exact against what it ports: CPython's math.hypot and pymunk's segment query.
 
 Bit-for-bit ``py_hypot`` over a million inputs of every magnitude; ``clear_line`` against
 ``space.segment_query_first`` on the five bundled levels (random sight lines and the
@@ -19,7 +19,7 @@ import shapely
 from numba import njit
 
 from game.agents import WALL_QUERY, build_space
-from game.batch.exact import TOUCH_EPS, WallGrid, clear_line, py_hypot, touches_wall
+from game.exact import TOUCH_EPS, WallGrid, clear_line, py_hypot, touches_wall
 from navmesh.level import Level, cached_level
 
 LEVELS = ("arkham", "dishonored", "maze", "miami", "tlou")

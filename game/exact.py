@@ -19,8 +19,11 @@ The wall queries take finite coordinates; :func:`py_hypot` takes any float.
 
 from __future__ import annotations
 
+import hashlib
 import math
 from collections.abc import Sequence
+from functools import lru_cache
+from pathlib import Path
 
 import numpy as np
 from numba import njit
@@ -230,7 +233,7 @@ def _wall_hits(segs: np.ndarray, w: int, root_leaf: bool,
 
 
 @njit(cache=True, error_model="numpy", inline="always")
-def _cell_range(lo: float, hi: float, origin: float, cell: float, n: int) -> tuple[int, int]:
+def cell_range(lo: float, hi: float, origin: float, cell: float, n: int) -> tuple[int, int]:
     """The clamped cell indices covering [lo, hi] along one axis (clamped as floats: a huge
     coordinate must not overflow the integer)."""
     f0 = math.floor((lo - origin) / cell)
@@ -241,18 +244,20 @@ def _cell_range(lo: float, hi: float, origin: float, cell: float, n: int) -> tup
 
 
 @njit(cache=True, error_model="numpy")
-def clear_line(segs: np.ndarray, cell_start: np.ndarray, cell_items: np.ndarray,
-               geom: np.ndarray, ax: float, ay: float, bx: float, by: float) -> bool:
-    """``space.segment_query_first((ax, ay), (bx, by), 0.0, WALL_QUERY) is None``.
+def blocking_wall(segs: np.ndarray, cell_start: np.ndarray, cell_items: np.ndarray,
+                  geom: np.ndarray, ax: float, ay: float, bx: float, by: float) -> int:
+    """A wall (its row in ``segs``) that makes ``space.segment_query_first((ax, ay),
+    (bx, by), 0.0, WALL_QUERY)`` report a hit, or -1 when it reports none (the line is
+    clear). Which of several blocking walls is named is unspecified (not pymunk's nearest).
 
     ``segs``, ``cell_start``, ``cell_items`` and ``geom`` are a :class:`WallGrid`'s; the
     walls of the cells under the segment's box are tested (a wall met twice is harmless).
     """
     nwalls = segs.shape[0]
     if nwalls == 0:
-        return True
+        return -1
     if nwalls == 1:  # the tree's root is the wall's leaf: no box culling
-        return not _wall_hits(segs, 0, True, ax, ay, bx, by)
+        return 0 if _wall_hits(segs, 0, True, ax, ay, bx, by) else -1
     x0 = geom[0]
     y0 = geom[1]
     cell = geom[2]
@@ -263,16 +268,24 @@ def clear_line(segs: np.ndarray, cell_start: np.ndarray, cell_items: np.ndarray,
     loy = ay if ay < by else by
     hiy = by if ay < by else ay
     if hix < x0 or hiy < y0 or lox > x0 + ncx * cell or loy > y0 + ncy * cell:
-        return True  # beyond every wall's margin
-    i0, i1 = _cell_range(lox, hix, x0, cell, ncx)
-    j0, j1 = _cell_range(loy, hiy, y0, cell, ncy)
+        return -1  # beyond every wall's margin
+    i0, i1 = cell_range(lox, hix, x0, cell, ncx)
+    j0, j1 = cell_range(loy, hiy, y0, cell, ncy)
     for j in range(j0, j1 + 1):
         for i in range(i0, i1 + 1):
             c = j * ncx + i
             for k in range(cell_start[c], cell_start[c + 1]):
                 if _wall_hits(segs, cell_items[k], False, ax, ay, bx, by):
-                    return False
-    return True
+                    return cell_items[k]
+    return -1
+
+
+@njit(cache=True, error_model="numpy")
+def clear_line(segs: np.ndarray, cell_start: np.ndarray, cell_items: np.ndarray,
+               geom: np.ndarray, ax: float, ay: float, bx: float, by: float) -> bool:
+    """``space.segment_query_first((ax, ay), (bx, by), 0.0, WALL_QUERY) is None``
+    (:func:`blocking_wall` finds no wall)."""
+    return blocking_wall(segs, cell_start, cell_items, geom, ax, ay, bx, by) < 0
 
 
 @njit(cache=True, error_model="numpy")
@@ -294,8 +307,8 @@ def touches_wall(segs: np.ndarray, cell_start: np.ndarray, cell_items: np.ndarra
     if (x + reach < x0 or y + reach < y0 or x - reach > x0 + ncx * cell
             or y - reach > y0 + ncy * cell):
         return False
-    i0, i1 = _cell_range(x - reach, x + reach, x0, cell, ncx)
-    j0, j1 = _cell_range(y - reach, y + reach, y0, cell, ncy)
+    i0, i1 = cell_range(x - reach, x + reach, x0, cell, ncx)
+    j0, j1 = cell_range(y - reach, y + reach, y0, cell, ncy)
     for j in range(j0, j1 + 1):
         for i in range(i0, i1 + 1):
             c = j * ncx + i
@@ -388,4 +401,40 @@ class WallGrid:
         return cls(np.ascontiguousarray(segs), cell_start, np.ascontiguousarray(cell_items), geom)
 
 
-__all__ = ["GRID_MARGIN", "TOUCH_EPS", "WallGrid", "clear_line", "py_hypot", "touches_wall"]
+def wall_grid(walls: np.ndarray) -> WallGrid:
+    """The :class:`WallGrid` of ``walls`` (``(m, 2, 2)`` or ``(m, 4)``), built once per set
+    of walls: every trial of a level shares it (read-only)."""
+    segs = np.ascontiguousarray(np.asarray(walls, dtype=np.float64).reshape(-1, 4))
+    return _wall_grid(segs.tobytes())
+
+
+@lru_cache(maxsize=16)
+def _wall_grid(data: bytes) -> WallGrid:
+    segs = np.frombuffer(data, dtype=np.float64).reshape(-1, 4)
+    grid = WallGrid.build([((a, b), (c, d)) for a, b, c, d in segs.tolist()])
+    for array in grid.arrays:
+        array.flags.writeable = False
+    return grid
+
+
+def forget_stale_cache(module_file: str) -> None:
+    """numba's on-disk cache of a module is keyed on that file alone, yet kernels that call
+    this module's functions compile them in: when this file changed since the module
+    ``module_file`` was cached, drop that module's cached kernels (call at its import)."""
+    here = Path(module_file)
+    cache = here.parent / "__pycache__"
+    stamp = hashlib.sha256(Path(__file__).read_bytes()).hexdigest()[:16]
+    mark = cache / f"{here.stem}.exact-{stamp}"
+    if mark.exists():
+        return
+    try:
+        for old in cache.glob(f"{here.stem}.*"):
+            old.unlink()
+        cache.mkdir(exist_ok=True)
+        mark.touch()
+    except OSError:  # a read-only install: its cache was made with the files it ships
+        pass
+
+
+__all__ = ["GRID_MARGIN", "TOUCH_EPS", "WallGrid", "blocking_wall", "cell_range", "clear_line",
+           "forget_stale_cache", "py_hypot", "touches_wall", "wall_grid"]
