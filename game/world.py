@@ -126,7 +126,7 @@ class World(PlayerActions):
         if self.player_policy is not None:
             self.player_policy.reset(self.graph, player_rng)
         for i, guard in enumerate(self.guards):
-            self._enter_node(guard, guard.node, i)
+            self.enter_node(guard, guard.node, i)
             guard.history.append(guard.node)
 
         # Stimuli (ai.stimuli): world events become field layers for the guard AI's hooks.
@@ -302,17 +302,23 @@ class World(PlayerActions):
         centre, the controller never saw it arrive and sent it there again, for ever (issue 24).
         """
         if self.locomotion.settle(agent, before, speed, self.stuck_timeout):
-            if agent is not self.player:
-                self.m.count_arrival(agent.history, agent.target)
-            node = agent.target
-        elif agent.pos == before:
+            self.arrived(index, agent)
             return
-        else:
-            node = self.graph.node_near(agent.pos[0], agent.pos[1], agent.node)
+        if agent.pos == before:
+            return
+        node = self.graph.node_near(agent.pos[0], agent.pos[1], agent.node)
         if node != agent.node:
-            self._enter_node(agent, node, index)
+            self.enter_node(agent, node, index)
 
-    def _enter_node(self, agent: Agent, node: int, index: int) -> None:
+    def arrived(self, index: int, agent: Agent) -> None:
+        """Agent number ``index`` has just reached its target (its last waypoint): a guard's
+        arrival is scored, and the agent stands on the target from now on."""
+        if agent is not self.player:
+            self.m.count_arrival(agent.history, agent.target)
+        if agent.target != agent.node:
+            self.enter_node(agent, agent.target, index)
+
+    def enter_node(self, agent: Agent, node: int, index: int) -> None:
         """``agent`` (guard number ``index``, or the player) now stands on ``node``."""
         agent.node = node
         if agent is not self.player:

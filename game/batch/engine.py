@@ -106,12 +106,18 @@ class Batch:
         if self.graph.cell_node is not None:
             self.cell_node = np.ascontiguousarray(self.graph.cell_node, dtype=np.int64)
             self.tri_eqs, self.tri_tol = np.zeros((0, 9)), 0.0
+            self.locate_geom = np.zeros(6)
+            self.locate_start = np.zeros(1, dtype=np.int64)
+            self.locate_items = np.zeros(0, dtype=np.int64)
         else:
             mesh = self.graph.mesh
             assert mesh is not None
             self.cell_node = kernels.empty_cells()
             self.tri_eqs = np.ascontiguousarray(np.asarray(mesh._edge_py, dtype=np.float64))
             self.tri_tol = float(mesh.tol)
+            self.locate_geom = np.array(mesh._grid, dtype=np.float64)
+            self.locate_start = np.ascontiguousarray(mesh._cell_start, dtype=np.int64)
+            self.locate_items = np.ascontiguousarray(mesh._cell_items, dtype=np.int64)
         self._arrays()
         for b in range(len(self.worlds)):
             self.push(b)
@@ -128,6 +134,9 @@ class Batch:
         self.cmd = np.zeros(shape + (2,))
         self.wp = np.zeros(shape + (2,))
         self.has_wp = np.zeros(shape, dtype=np.bool_)
+        self.n_wp = np.zeros(shape, dtype=np.int64)  # waypoints left (the deque's length)
+        self.kind = np.zeros(shape, dtype=np.int8)  # what kernels.settle made of the step
+        self.new_node = np.zeros(shape, dtype=np.int64)
         self.cruise_ok = np.zeros(shape, dtype=np.bool_)
         self.cruise_speed = np.zeros(shape)
         self.cruise_rem = np.zeros(shape)
@@ -150,7 +159,6 @@ class Batch:
         self.seen = np.array([_bits(w.seen_by) for w in self.worlds], dtype=np.int64)
         self.attackers = np.array([w.attackers for w in self.worlds], dtype=np.int64)
         self.key_changed = np.zeros(n_trials, dtype=np.bool_)
-        self.slow = np.zeros(shape, dtype=np.bool_)
         self.touch = np.zeros(n_trials, dtype=np.bool_)
         self.held = np.zeros(n_trials, dtype=np.int64)  # steps left in pymunk's hands
         self.ended = ~self.live  # trials whose world is done: not stepped after this step
@@ -195,6 +203,7 @@ class Batch:
                 self.vel[b, a, 0], self.vel[b, a, 1] = agent.velocity
             waypoints = agent.waypoints
             self.has_wp[b, a] = bool(waypoints)
+            self.n_wp[b, a] = len(waypoints)
             if waypoints:
                 self.wp[b, a, 0], self.wp[b, a, 1] = waypoints[0]
             cruise = agent.cruise
@@ -244,18 +253,14 @@ class Batch:
         self.step_index += 1
         for b in np.flatnonzero(live & (self.attackers > 0)).tolist():
             self._hurt(b, before)
-        kernels.settle(live, self.pos, before, self.has_wp, self.wp, speeds, dt, self.since,
-                       self.on_track, self.node, self.stuck_timeout, self.radius,
-                       self.cell_node, self.graph.cell_size, self.tri_eqs, self.tri_tol,
-                       self.slow)
-        for b, a in np.argwhere(self.slow & live[:, None]).tolist():
-            world = self.worlds[b]
-            self.pull(b, a)
-            world.step_index = self.step_index
-            world.settle_agent(int(a), self.agents(b)[a],
-                               (float(before[b, a, 0]), float(before[b, a, 1])),
-                               float(speeds[b, a]))
-            self.push(b, a)
+        kernels.settle(live, self.pos, before, self.has_wp, self.n_wp, self.wp, self.cruise_ok,
+                       speeds, dt, self.since, self.on_track, self.node, self.stuck_timeout,
+                       self.radius, self.cell_node, self.graph.cell_size, self.tri_eqs,
+                       self.tri_tol, self.locate_geom, self.locate_start, self.locate_items,
+                       self.kind, self.new_node)
+        events = live[:, None] & (self.kind != kernels.QUIET)
+        for b, a, kind in zip(*np.nonzero(events), self.kind[events].tolist()):
+            self._settle(int(b), int(a), kind, before, speeds)
         for b in np.flatnonzero(live & self.sprinting).tolist():  # footsteps: the world's rule
             self.pull(b)
             self.worlds[b].moved((float(before[b, -1, 0]), float(before[b, -1, 1])), True)
@@ -271,6 +276,26 @@ class Batch:
                 self.worlds[b].done = True
             self.ended[live] = True
         live[self.ended] = False
+
+    def _settle(self, b: int, a: int, kind: int, before: np.ndarray, speeds: np.ndarray) -> None:
+        """What :func:`kernels.settle` flagged for agent ``a`` of trial ``b``: a node entered
+        or the target reached run the world's rule alone (the kernel committed the rest);
+        anything else is :meth:`World.settle_agent` on the agent's whole state."""
+        world = self.worlds[b]
+        world.step_index = self.step_index
+        agent = self.agents(b)[a]
+        if kind == kernels.ENTERED:
+            world.enter_node(agent, int(self.new_node[b, a]), a)
+            self.node[b, a] = agent.node
+        elif kind == kernels.ARRIVED:
+            agent.waypoints.popleft()
+            world.arrived(a, agent)
+            self.node[b, a] = agent.node
+        else:
+            self.pull(b, a)
+            world.settle_agent(a, agent, (float(before[b, a, 0]), float(before[b, a, 1])),
+                               float(speeds[b, a]))
+            self.push(b, a)
 
     def _hurt(self, b: int, before: np.ndarray) -> None:
         """Damage in trial ``b`` as :meth:`World.hurt` deals it, where the reference deals

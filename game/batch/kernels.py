@@ -94,13 +94,19 @@ def touching(live, pos, radius, segs, cell_start, cell_items, geom, out):
                 break
 
 
+#: what :func:`settle` made of an agent's step
+QUIET, ENTERED, ARRIVED, SLOW = 0, 1, 2, 3
+
+
 @njit(cache=True)
-def settle(live, pos, before, has_wp, wp, speed, dt, since, on_track, node, stuck_timeout,
-           radius, cell_node, cell_size, tri_eqs, tri_tol, slow):
-    """``World.settle_agent`` where nothing happens but time passing: no waypoint reached,
-    not stuck, still on its node (grid: the cell under the centre; partition: inside its
-    triangle). It then commits ``on_track`` and ``since``; any other agent is flagged in
-    ``slow`` with its state untouched, for the world's rule to run."""
+def settle(live, pos, before, has_wp, n_wp, wp, cruise_ok, speed, dt, since, on_track, node,
+           stuck_timeout, radius, cell_node, cell_size, tri_eqs, tri_tol, locate_geom,
+           locate_start, locate_items, kind, new_node):
+    """``World.settle_agent`` for every agent, as far as it runs without Python: ``kind``
+    says what it made of each agent's step — QUIET (time passed), ENTERED (a node entered
+    by walking, ``new_node``), ARRIVED (its last waypoint reached: the target) — those three
+    with ``on_track`` and ``since`` committed; SLOW (a waypoint passed, a stall, stuck, a
+    point off the graph's cells) with its state untouched, for the world's rule to run."""
     n_trials, n_agents = live.shape[0], pos.shape[1]
     grid = cell_node.shape[0] > 0
     for b in range(n_trials):
@@ -112,31 +118,73 @@ def settle(live, pos, before, has_wp, wp, speed, dt, since, on_track, node, stuc
             moved = py_hypot(x - bx, y - by)
             expected = speed[b, a] * dt
             waiting = since[b, a] + dt
+            result = QUIET
             if has_wp[b, a]:
                 d = py_hypot(wp[b, a, 0] - x, wp[b, a, 1] - y)
                 stalled = moved < 0.25 * expected
-                if d <= ARRIVE_EPS or (stalled and d <= radius + 0.05) or waiting > stuck_timeout:
-                    slow[b, a] = True
+                if d <= ARRIVE_EPS or (stalled and d <= radius + 0.05):
+                    if n_wp[b, a] != 1:
+                        kind[b, a] = SLOW
+                        continue
+                    result = ARRIVED  # Locomotion.advance: the target reached, no stuck test
+                elif waiting > stuck_timeout:
+                    kind[b, a] = SLOW
                     continue
-            if x != bx or y != by:
+            if result == QUIET and (x != bx or y != by):
                 n = node[b, a]
                 if grid:
                     row = math.floor(y / cell_size)
                     col = math.floor(x / cell_size)
                     if (row < 0 or row >= cell_node.shape[0] or col < 0
-                            or col >= cell_node.shape[1] or cell_node[row, col] != n):
-                        slow[b, a] = True
+                            or col >= cell_node.shape[1] or cell_node[row, col] < 0):
+                        kind[b, a] = SLOW  # off the cells: the nearest node, in Python
                         continue
+                    m = cell_node[row, col]
                 else:
-                    e = tri_eqs[n]
-                    eps = -tri_tol
-                    if not (e[0] * x + e[1] * y + e[2] >= eps and e[3] * x + e[4] * y + e[5] >= eps
-                            and e[6] * x + e[7] * y + e[8] >= eps):
-                        slow[b, a] = True
-                        continue
-            slow[b, a] = False
+                    m = n
+                    if not _in_triangle(tri_eqs, tri_tol, n, x, y):
+                        m = _locate(tri_eqs, tri_tol, locate_geom, locate_start, locate_items,
+                                    x, y)
+                        if m < 0:
+                            kind[b, a] = SLOW
+                            continue
+                if m != n:
+                    result = ENTERED
+                    new_node[b, a] = m
+            kind[b, a] = result
             on_track[b, a] = abs(moved - expected) < 1e-9
             since[b, a] = waiting
+            if result == ARRIVED:
+                has_wp[b, a] = False
+                n_wp[b, a] = 0
+                cruise_ok[b, a] = False
+
+
+@njit(cache=True, inline="always")
+def _in_triangle(tri_eqs, tri_tol, t, x, y):
+    """``NavMesh.triangle_contains``: the same three edge tests, boundary included."""
+    e = tri_eqs[t]
+    eps = -tri_tol
+    return (e[0] * x + e[1] * y + e[2] >= eps and e[3] * x + e[4] * y + e[5] >= eps
+            and e[6] * x + e[7] * y + e[8] >= eps)
+
+
+@njit(cache=True)
+def _locate(tri_eqs, tri_tol, geom, cell_start, cell_items, x, y):
+    """``NavMesh.locate``: the first triangle of (x, y)'s bucket that contains it, or -1."""
+    x0, y0, sx, sy, nx, ny = geom[0], geom[1], geom[2], geom[3], int(geom[4]), int(geom[5])
+    fx = (x - x0) * sx
+    fy = (y - y0) * sy
+    if not (-0.5 <= fx <= nx + 0.5 and -0.5 <= fy <= ny + 0.5):
+        return -1
+    i = min(max(int(fx), 0), nx - 1)
+    j = min(max(int(fy), 0), ny - 1)
+    c = j * nx + i
+    for k in range(cell_start[c], cell_start[c + 1]):
+        t = cell_items[k]
+        if _in_triangle(tri_eqs, tri_tol, t, x, y):
+            return t
+    return -1
 
 
 @njit(cache=True)
