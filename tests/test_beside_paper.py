@@ -91,3 +91,42 @@ def test_analyse_errors_are_the_same_one_line(tmp_path: Path, name: str, module:
     assert via_m.stderr == via_cli.stderr and via_cli.stdout == b""
     lines = via_cli.stderr.decode().splitlines()
     assert len(lines) == 1 and lines[0].startswith("stealth: error: "), lines
+
+
+@pytest.mark.parametrize("table,what", [
+    ("a,b\n1,2\n", "no column abstraction, guards, player (and 9 more): not a table.csv"),
+    ("", "no rows: not a table.csv of stealth report"),
+    (None, "line 2: CaptureTime_mean = 'abc' is not a number"),
+    (b"abstraction,guards\n\xff\xfe,1\n", "not UTF-8 text (byte 19)"),
+])
+def test_a_table_that_is_not_ours_is_one_line_naming_the_file(
+        tmp_path: Path, capsys: pytest.CaptureFixture[str], table: str | bytes | None,
+        what: str) -> None:
+    report = _report(tmp_path / "other", 0.5)
+    path = report / "table.csv"
+    if table is None:  # our columns, a mean that is not a number
+        text = path.read_text(encoding="utf-8").splitlines()
+        head = text[0].split(",")
+        row = text[1].split(",")
+        row[head.index("CaptureTime_mean")] = "abc"
+        path.write_text("\n".join([text[0], ",".join(row)]) + "\n", encoding="utf-8")
+    elif isinstance(table, bytes):
+        path.write_bytes(table)
+    else:
+        path.write_text(table, encoding="utf-8")
+    assert main([str(report)]) == 2
+    captured = capsys.readouterr()
+    lines = captured.err.splitlines()
+    assert captured.out == "" and len(lines) == 1, lines
+    assert lines[0] == f"stealth: error: {path}: {what}" or (
+        lines[0].startswith(f"stealth: error: {path}: ") and what in lines[0]), lines[0]
+
+
+def test_a_table_md_that_is_not_utf8_is_one_line(tmp_path: Path,
+                                                 capsys: pytest.CaptureFixture[str]) -> None:
+    report = _report(tmp_path / "paper", 0.5)
+    (report / "table.md").write_bytes(b"# Table\n\xff\n")
+    assert main([str(report)]) == 2
+    lines = capsys.readouterr().err.splitlines()
+    assert lines == [f"stealth: error: {report / 'table.md'}: not UTF-8 text (byte 8): not a "
+                     "report of stealth report"]

@@ -12,11 +12,13 @@ from __future__ import annotations
 
 import argparse
 import csv
+import io
 import sys
 from collections.abc import Mapping, Sequence
 from pathlib import Path
 
 from ..commands.failure import GuardedParser, guarded, wants_debug
+from ..errors import UserError
 from ..outputs.clobber import refuse_inputs_all
 from .markers import replace_marked
 from .paper import paper_table3
@@ -34,9 +36,39 @@ _BEGIN, _END = "<!-- beside-paper -->", "<!-- /beside-paper -->"
 _TITLES = {"grid": "Grid", "partition": "Partition"}
 
 
+#: the columns of a ``stealth report`` table.csv read here (besides each column's ``_mean``)
+_KEYS = ("abstraction", "guards", "player", "GuardMode", "PlayerMode")
+
+
+def _text(path: Path) -> str:
+    """``path``'s text; a file that is not UTF-8 is one line naming it."""
+    data = path.read_bytes()
+    try:
+        return data.decode("utf-8")
+    except UnicodeDecodeError as error:
+        raise UserError(f"{path}: not UTF-8 text (byte {error.start}): not a report of "
+                        "stealth report") from None
+
+
 def _rows(path: Path) -> list[dict[str, str]]:
-    with path.open(newline="", encoding="utf-8") as handle:
-        return list(csv.DictReader(handle))
+    """The rows of a ``stealth report`` table.csv; another table (missing columns, a mean
+    that is not a number) is one line naming the file and what is wrong."""
+    rows = list(csv.DictReader(io.StringIO(_text(path), newline="")))
+    header = set(rows[0]) if rows else set()
+    missing = [c for c in (*_KEYS, *(f"{c}_mean" for c, _ in COLUMNS)) if c not in header]
+    if not rows or missing:
+        what = "no rows" if not rows else "no column " + ", ".join(missing[:3]) + (
+            f" (and {len(missing) - 3} more)" if len(missing) > 3 else "")
+        raise UserError(f"{path}: {what}: not a table.csv of stealth report")
+    for line, row in enumerate(rows, start=2):
+        for column, _ in COLUMNS:
+            value = row[f"{column}_mean"]
+            try:
+                float(value)
+            except (TypeError, ValueError):
+                raise UserError(f"{path}: line {line}: {column}_mean = {value!r} is not a "
+                                "number") from None
+    return rows
 
 
 def _table(abstraction: str, ours: Sequence[Mapping[str, str]],
@@ -70,7 +102,7 @@ def beside_paper(directory: Path, literal: Path | None = None) -> str:
     out: list[str] = []
     for abstraction in dict.fromkeys(r["abstraction"] for r in ours):
         out += _table(abstraction, ours, lit) + [""]
-    full = (directory / "table.md").read_text(encoding="utf-8")
+    full = _text(directory / "table.md")
     body = full.split("\n## ", 1)[1] if "\n## " in full else full
     out += ["Our full table, with sample standard deviations and 95 % bootstrap confidence "
             "intervals of", "the mean:", "", "## " + body.strip()]
