@@ -62,10 +62,12 @@ the start rule's farthest hidden node, a hidden node drawn uniformly, or where i
 (``stay``: HP restored, no teleport; the paper's trial runs "regardless of the player's
 health status")."""
 
-ENGINES = ("pymunk", "batch")
+ENGINES = ("auto", "pymunk", "batch")
 """``world.engine`` (SPEC §12): what advances a headless trial. ``pymunk``: the reference,
 one :class:`~game.world.World` per trial; ``batch``: the trials of one level and abstraction
-advanced in lockstep over arrays (:mod:`game.batch`). Both give the same rows trial for trial,
+advanced in lockstep over arrays (:mod:`game.batch`); ``auto`` (the default): a sweep or a
+study runs on ``batch`` the trials it covers and on ``pymunk`` the rest, one trial alone
+(``stealth sim``, ``play``, the envs) on ``pymunk``. All give the same rows trial for trial,
 so the engine is no part of a trial's identity (``game.config.IDENTITY_NEUTRAL``)."""
 
 SEED = Range(0, 2**63 - 1, integer=True)

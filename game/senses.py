@@ -36,9 +36,13 @@ class Senses:
     False
     """
 
-    def __init__(self, space: pymunk.Space, fov_deg: float) -> None:
+    def __init__(self, space: pymunk.Space, fov_deg: float,
+                 walls: np.ndarray | None = None) -> None:
         self.space = space
         self.cos_half_fov = math.cos(math.radians(float(fov_deg)) / 2)
+        #: the space's walls as (m, 2, 2) ends, when the caller has them: the many-point
+        #: :meth:`visible_points` then runs compiled (the same query, bit for bit)
+        self.walls = None if walls is None else np.asarray(walls, dtype=np.float64)
 
     def clear_line(self, a: Point, b: Point) -> bool:
         """No wall between ``a`` and ``b``."""
@@ -70,9 +74,19 @@ class Senses:
                        reach: float) -> np.ndarray:
         """Mask of the ``points`` (k, 2) that :meth:`perceives` from ``origin``.
 
-        A vectorised distance bound (with slack, so it only ever keeps more) picks the
-        candidates; each candidate then gets the one test.
+        With the walls known (``walls``), a compiled loop repeats :meth:`perceives` over the
+        points (:func:`game.sight_kernels.visible`: its operations in its order, pymunk's
+        query by its exact port); else a vectorised distance bound (with slack, so it only
+        ever keeps more) picks the candidates and each gets the one test.
         """
+        if self.walls is not None:
+            from .exact import wall_grid
+            from .sight_kernels import visible
+
+            pts = np.ascontiguousarray(points, dtype=np.float64).reshape(-1, 2)
+            return visible(float(origin[0]), float(origin[1]), math.cos(heading),
+                           math.sin(heading), pts, float(reach), self.cos_half_fov,
+                           *wall_grid(self.walls).arrays)
         delta = points - origin
         near = np.flatnonzero(np.hypot(delta[:, 0], delta[:, 1]) <= reach + 1e-6)
         mask = np.zeros(len(points), dtype=bool)

@@ -92,7 +92,7 @@ class World(PlayerActions):
 
         self._watched: frozenset[int] = frozenset()
         self.space = build_space(level)
-        self.senses = Senses(self.space, float(w["fov_deg"]))
+        self.senses = Senses(self.space, float(w["fov_deg"]), level.walls)
         self.locomotion = Locomotion(self.space, self.graph, level, self.radius, self.dt)
         self.step_index = 0
         self.done = False
@@ -108,7 +108,7 @@ class World(PlayerActions):
         self.m: Counters = Counters.for_nodes(self.graph.n)
         # metrics.coverage = "seen": a node is seen as a player standing on it would be
         self.m.view_cover = ViewCover(self.graph, self.senses,
-                                      self.view_range * self.view_scale_at)
+                                      self.view_range * self.view_scale_at, level.walls)
 
         guard_speed = self.guard_speed = float(w["guard_speed"])
         player_speed = float(w["player_speed"]) * float(s["player_speed_scale"])

@@ -27,19 +27,19 @@ from headless.errors import PresetError
 from headless.executors import run_engine_batch
 from headless.presets import load_preset
 from headless.store import ResultStore
-from headless.sweep import batch_tasks
+from headless.engines import batch_tasks
 
 SHORT = (("world.duration", 2.0),)
 
 
 # ------------------------------------------------------------------ the key and its identity
-def test_the_engine_is_a_world_key_whose_default_is_the_reference() -> None:
-    assert Config.defaults()["world.engine"] == "pymunk"
+def test_the_engine_is_a_world_key_whose_default_is_auto() -> None:
+    assert Config.defaults()["world.engine"] == "auto"
     assert Config.load(["world.engine=batch"])["world.engine"] == "batch"
 
 
 def test_an_unknown_engine_is_refused_naming_the_key_and_the_engines() -> None:
-    with pytest.raises(ConfigError, match=r"world\.engine = 'gpu': must be one of 'pymunk', 'batch'"):
+    with pytest.raises(ConfigError, match=r"world\.engine = 'gpu': must be one of 'auto', 'pymunk', 'batch'"):
         Config.load(["world.engine=gpu"])
 
 
@@ -47,6 +47,7 @@ def test_the_engine_is_out_of_the_config_hash() -> None:
     assert Config.load(["world.engine=batch"]).hash() == Config.defaults().hash() \
         == "c53787ba3cd08da1"
     assert Config.load(["world.engine=pymunk"]).hash() == Config.defaults().hash()
+    assert Config.load(["world.engine=auto"]).hash() == Config.defaults().hash()
     # still sensitive to everything else
     assert Config.load(["world.engine=batch", "pf.rho=0.9"]).hash() == "6e28a1d79ad34ffd"
 
@@ -70,7 +71,7 @@ def test_sim_refuses_an_unknown_engine_in_one_line(capsys: pytest.CaptureFixture
     assert main(["sim", "maze", "--set", "world.engine=gpu"]) == 2
     captured = capsys.readouterr()
     lines = [line for line in captured.err.splitlines() if line.strip()]
-    assert lines == ["stealth: error: world.engine = 'gpu': must be one of 'pymunk', 'batch'"]
+    assert lines == ["stealth: error: world.engine = 'gpu': must be one of 'auto', 'pymunk', 'batch'"]
     assert captured.out == ""
 
 
@@ -130,7 +131,7 @@ def _preset(tmp_path: Path, extra: str = "", set_: str = "") -> Path:
 def test_the_engine_of_a_preset_is_no_part_of_its_design_or_keys(tmp_path: Path) -> None:
     plain = load_preset(str(_preset(tmp_path)))
     batch = load_preset(str(_preset(tmp_path, set_='"world.engine" = "batch"')))
-    assert (plain.engine, batch.engine) == ("pymunk", "batch")
+    assert (plain.engine, batch.engine) == ("auto", "batch")
     assert batch.design() == plain.design() and batch.overrides == plain.overrides
     assert [s.key for s in batch.specs()] == [s.key for s in plain.specs()]
     assert batch.config_hash == plain.config_hash
@@ -153,7 +154,7 @@ def test_run_refuses_an_unknown_engine_in_one_line(tmp_path: Path,
     code = main(["run", "--preset", str(_preset(tmp_path)), "--out", str(out),
                  "--set", "world.engine=gpu"])
     assert code == 2 and not out.exists()
-    assert "world.engine = 'gpu': must be one of 'pymunk', 'batch'" in _one_error_line(
+    assert "world.engine = 'gpu': must be one of 'auto', 'pymunk', 'batch'" in _one_error_line(
         capsys.readouterr().err)
 
 
@@ -234,11 +235,52 @@ def test_run_on_the_reference_engine_never_asks_the_batch_engine(
     monkeypatch.setattr(batch_module, "uncovered", refuse)
     out = tmp_path / "out"
     assert main(["run", "--preset", str(_preset(tmp_path)), "--out", str(out),
-                 "--workers", "1"]) == 0
+                 "--workers", "1", "--set", "world.engine=pymunk"]) == 0
     first = capsys.readouterr().err.splitlines()[0]
-    assert first.endswith(f"-> {out}")  # today's first line: no engine said
+    assert first.endswith(f"-> {out} (engine pymunk)")
     with ResultStore(out / "results.sqlite", readonly=True) as store:
         assert {t["engine"] for t in store.trials()} == {"pymunk"}
+
+
+def test_auto_runs_what_the_batch_engine_covers_on_it_and_the_rest_on_pymunk(
+        tmp_path: Path, batch_module: types.ModuleType, monkeypatch: pytest.MonkeyPatch,
+        capsys: pytest.CaptureFixture[str]) -> None:
+    monkeypatch.setattr(batch_module, "uncovered",
+                        lambda spec, config: TEAM if spec.guards == "random" else None)
+    out = tmp_path / "out"
+    assert main(["run", "--preset", str(_preset(tmp_path)), "--out", str(out),
+                 "--workers", "1"]) == 0  # the default engine: auto
+    first = capsys.readouterr().err.splitlines()[0]
+    assert first.endswith(f"-> {out} (engine auto: batch for 2 trials, pymunk for 2 (the "
+                          f"batch engine does not cover {TEAM}))")
+    with ResultStore(out / "results.sqlite", readonly=True) as store:
+        engines = {(t["guards"], t["engine"]) for t in store.trials()}
+    assert engines == {("cheat", "batch"), ("random", "pymunk")}
+
+
+def test_auto_says_batch_when_it_covers_every_trial(
+        tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    out = tmp_path / "out"
+    assert main(["run", "--preset", str(_preset(tmp_path)), "--out", str(out),
+                 "--workers", "1"]) == 0
+    assert capsys.readouterr().err.splitlines()[0].endswith(f"-> {out} (engine auto: batch)")
+    with ResultStore(out / "results.sqlite", readonly=True) as store:
+        assert {t["engine"] for t in store.trials()} == {"batch"}
+
+
+def test_a_study_evaluates_on_both_engines_in_its_trials_order(
+        batch_module: types.ModuleType, monkeypatch: pytest.MonkeyPatch) -> None:
+    from headless.executors import InlineExecutor
+    from headless.tune.study import evaluate
+
+    monkeypatch.setattr(batch_module, "uncovered",
+                        lambda spec, config: TEAM if spec.guards == "random" else None)
+    specs = [TrialSpec("maze", guards=g, seed=s, overrides=SHORT)
+             for s in range(4) for g in ("cheat", "random")]
+    rows = evaluate(InlineExecutor(), specs, 1, "auto")
+    assert [r["key"] for r in rows] == [s.key for s in specs]
+    assert [r["engine"] for r in rows] == ["batch", "pymunk"] * 4  # the batch's come first
+    assert all(r["metrics"] == run_trial(s)["metrics"] for r, s in zip(rows, specs))
 
 
 def test_run_on_the_batch_engine_maps_run_trials_over_its_batches(
@@ -314,4 +356,4 @@ def test_a_store_from_before_the_engine_column_resumes(tmp_path: Path,
     with ResultStore(path, readonly=True) as store:
         engines = sorted((t["seed"], t["engine"] or "") for t in store.trials())
     assert [e for s, e in engines if s < 2] == [""] * 4  # the old rows: not known
-    assert [e for s, e in engines if s == 2] == ["pymunk"] * 2
+    assert [e for s, e in engines if s == 2] == ["batch"] * 2  # auto: the batch engine covers them

@@ -307,3 +307,46 @@ def test_timings() -> None:
     per_hypot = (time.perf_counter() - start) / len(x)
     print(f"\nclear_line: {per_line * 1e9:.0f} ns/call ({clear.mean():.0%} clear); "
           f"py_hypot: {per_hypot * 1e9:.1f} ns/call")
+
+
+@pytest.mark.parametrize("name", ["arkham", "miami"])
+def test_blocking_wall_names_a_wall_exactly_when_pymunk_reports_a_hit(name: str) -> None:
+    from game.exact import blocking_wall, wall_grid
+
+    level = cached_level(name)
+    space, grid = build_space(level), wall_grid(level.walls)
+    rng = np.random.default_rng(7)
+    pts = np.asarray(level.walls, dtype=np.float64).reshape(-1, 2)
+    lo, hi = pts.min(axis=0) - 1, pts.max(axis=0) + 1
+    for a, b in rng.uniform(lo, hi, size=(2000, 2, 2)).tolist():
+        wall = blocking_wall(*grid.arrays, a[0], a[1], b[0], b[1])
+        hit = space.segment_query_first(tuple(a), tuple(b), 0.0, WALL_QUERY)
+        assert (wall >= 0) == (hit is not None)
+        if wall >= 0:  # the named wall itself stops the line
+            one = pymunk.Space()
+            (wa, wb) = level.walls[wall]
+            seg = pymunk.Segment(one.static_body, tuple(wa), tuple(wb), 0.0)
+            one.add(seg)
+            assert one.segment_query_first(tuple(a), tuple(b), 0.0,
+                                           pymunk.ShapeFilter()) is not None
+
+
+@pytest.mark.parametrize("name", ["dishonored", "tlou"])
+def test_compiled_visible_points_equal_the_pymunk_ones(name: str) -> None:
+    from game.senses import Senses
+
+    level = cached_level(name)
+    space = build_space(level)
+    pymunk_senses, compiled = Senses(space, 90.0), Senses(space, 90.0, level.walls)
+    pts = np.asarray(level.walls, dtype=np.float64).reshape(-1, 2)
+    lo, hi = pts.min(axis=0), pts.max(axis=0)
+    rng = np.random.default_rng(3)
+    points = rng.uniform(lo, hi, size=(3000, 2))
+    seen = 0
+    for origin, heading in zip(rng.uniform(lo, hi, size=(20, 2)).tolist(),
+                               rng.uniform(-math.pi, math.pi, 20).tolist()):
+        want = pymunk_senses.visible_points(tuple(origin), heading, points, 9.0)
+        got = compiled.visible_points(tuple(origin), heading, points, 9.0)
+        assert np.array_equal(want, got)
+        seen += int(want.sum())
+    assert seen > 100  # the origins saw something: the masks are not trivially empty

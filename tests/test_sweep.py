@@ -267,7 +267,9 @@ def test_failed_trial_is_recorded_the_sweep_goes_on_and_a_rerun_retries_it(
 
     monkeypatch.setattr(executors, "run_trial", flaky)
     out = tmp_path / "out"
-    assert main(["run", "--preset", str(preset_path), "--out", str(out), "--workers", "1"]) == 1
+    pymunk = ["--set", "world.engine=pymunk"]  # a trial of its own fails alone
+    assert main(["run", "--preset", str(preset_path), "--out", str(out), "--workers", "1",
+                 *pymunk]) == 1
     err = capsys.readouterr().err
     assert "6 finished, 2 failed, 0 skipped" in err and "simulated crash" in err
     with ResultStore(out / "results.sqlite", readonly=True) as store:
@@ -277,7 +279,8 @@ def test_failed_trial_is_recorded_the_sweep_goes_on_and_a_rerun_retries_it(
         assert "Traceback" in failed["error"]
 
     monkeypatch.setattr(executors, "run_trial", real)
-    assert main(["run", "--preset", str(preset_path), "--out", str(out), "--workers", "1"]) == 0
+    assert main(["run", "--preset", str(preset_path), "--out", str(out), "--workers", "1",
+                 *pymunk]) == 0
     assert "2 finished, 0 failed, 6 skipped" in capsys.readouterr().err
     with ResultStore(out / "results.sqlite", readonly=True) as store:
         assert store.count() == (8, 0)
@@ -304,7 +307,9 @@ def test_a_stored_rows_identity_is_the_specs_identity_row_failed_or_not(
 
     monkeypatch.setattr(executors, "run_trial", flaky)
     out = tmp_path / "out"
-    assert main(["run", "--preset", str(preset_path), "--out", str(out), "--workers", "1"]) == 1
+    pymunk = ["--set", "world.engine=pymunk"]  # a trial of its own fails alone
+    assert main(["run", "--preset", str(preset_path), "--out", str(out), "--workers", "1",
+                 *pymunk]) == 1
     capsys.readouterr()
     with ResultStore(out / "results.sqlite", readonly=True) as store:
         stored = [*store.trials(), *store.trials(failed=True)]
