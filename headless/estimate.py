@@ -6,7 +6,8 @@ Per-trial wall times were measured on the bundled levels with the ``quick`` pres
 scenario of its store). A trial of another level costs the mean of the table; a trial
 runs ``world.duration`` seconds of game time, so the cost scales with it. The estimate is
 the sum over the trials still to run divided by the workers, plus the pool's start; the
-progress bar's ETA then takes over with the real rate.
+progress bar's ETA then takes over with the real rate. A trial on the batch engine costs
+:data:`BATCH_COST` of its pymunk time.
 
 >>> round(estimate_seconds([("maze", "grid", "capture")] * 200, 2, 60.0), 1)
 9.3
@@ -18,7 +19,8 @@ from __future__ import annotations
 
 from collections.abc import Iterable
 
-__all__ = ["MEASURED_DURATION", "POOL_START", "TRIAL_SECONDS", "duration_text", "estimate_seconds"]
+__all__ = ["BATCH_COST", "MEASURED_DURATION", "POOL_START", "TRIAL_SECONDS", "duration_text",
+           "estimate_seconds"]
 
 MEASURED_DURATION = 60.0
 """``world.duration`` (game seconds) of the measured trials: the default."""
@@ -40,14 +42,21 @@ TRIAL_SECONDS: dict[tuple[str, str, str], float] = {
 }
 """Mean wall time (s) of one trial per (level, abstraction, scenario), measured as above."""
 
+BATCH_COST = 0.6
+"""A trial's time on the batch engine over its time on the pymunk engine: the inverse of
+``python benchmarks/batch.py --seeds 3``'s ratio of trials per CPU second (1.6-1.7 on
+2026-12-07, batches of 60 trials)."""
+
 _MEAN = sum(TRIAL_SECONDS.values()) / len(TRIAL_SECONDS)
 
 
 def estimate_seconds(trials: Iterable[tuple[str, str, str]], workers: int,
-                     duration: float) -> float:
-    """Expected wall time of running ``trials`` — (level name, abstraction, scenario) each —
-    on ``workers`` processes with ``world.duration = duration``."""
-    total = sum(TRIAL_SECONDS.get(trial, _MEAN) for trial in trials)
+                     duration: float, batch: Iterable[tuple[str, str, str]] = ()) -> float:
+    """Expected wall time of running ``trials`` on the pymunk engine and ``batch`` on the
+    batch engine — (level name, abstraction, scenario) each — on ``workers`` processes with
+    ``world.duration = duration``."""
+    total = (sum(TRIAL_SECONDS.get(trial, _MEAN) for trial in trials)
+             + BATCH_COST * sum(TRIAL_SECONDS.get(trial, _MEAN) for trial in batch))
     return POOL_START + total * (duration / MEASURED_DURATION) / max(1, workers)
 
 

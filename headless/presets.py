@@ -72,7 +72,7 @@ class Preset:
     factors: tuple[tuple[str, tuple[Any, ...]], ...] = ()
     #: ``world.engine`` the sweep runs the trials on (SPEC §12); no part of the design, the
     #: overrides, the trials' keys or the config hash: the engines give equal results
-    engine: str = "pymunk"
+    engine: str = "auto"
 
     @property
     def n_trials(self) -> int:

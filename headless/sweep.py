@@ -10,11 +10,12 @@ process is the only writer of the store and commits each trial as soon as it arr
 a killed sweep is resumed by running the same command again; :mod:`headless.progress`
 draws the bar.
 
-On the batch engine (``world.engine = "batch"``, :mod:`headless.engines`) every pending
-trial is first checked to be one the engine covers (one line and exit 2 if not, nothing
-written), and the task is :func:`~headless.executors.run_engine_batch` over
-:func:`batch_tasks`: up to ``game.batch.MAX_BATCH`` trials that share level, abstraction,
-overrides and factors, spread over the workers.
+The engine (``world.engine``, :mod:`headless.engines`) assigns the pending trials before
+anything is written: ``batch`` refuses a trial it does not cover (one line, exit 2),
+``auto`` (the default) runs the covered ones on the batch engine and the rest on pymunk,
+and the first line says which. A batch-engine task is
+:func:`~headless.executors.run_engine_batch` over up to ``game.batch.MAX_BATCH`` trials that
+share level, abstraction, overrides and factors (:func:`headless.engines.batch_tasks`).
 """
 
 from __future__ import annotations
@@ -22,12 +23,11 @@ from __future__ import annotations
 import argparse
 import concurrent.futures as cf
 import json
-import math
 import os
 import shlex
 import sys
 import time
-from collections.abc import Callable, Iterable, Iterator, Sequence
+from collections.abc import Callable, Iterable, Iterator
 from dataclasses import dataclass, field
 from datetime import datetime, timezone
 from pathlib import Path
@@ -40,15 +40,13 @@ from navmesh.level import zone_kinds
 
 from .outputs.dirlock import DirectoryLock
 from .errors import SweepError
-from .engines import BATCH, check_covered
+from .engines import Split, engine_tasks, split
 from .estimate import MEASURED_DURATION, duration_text, estimate_seconds
 from .executors import (
     InlineExecutor,
     check_workers,
     connect_dask,
     process_pool,
-    run_batch,
-    run_engine_batch,
     shutdown,
     terminate,
 )
@@ -58,9 +56,8 @@ from .presets import Preset, load_preset
 from .progress import Progress
 from .store import STORE_NAME, ResultStore
 
-__all__ = ["SweepResult", "batch_tasks", "cmd_run", "run_sweep"]
+__all__ = ["SweepResult", "cmd_run", "run_sweep"]
 
-_MAX_BATCH = 8  # trials per task: ~0.3-0.5 s of work, pickling overhead negligible
 
 
 @dataclass
@@ -91,47 +88,6 @@ class SweepResult:
         if self.first_error:
             text += f"; first error: {self.first_error}"
         return text
-
-
-def _batches(specs: Sequence[TrialSpec], size: int) -> Iterator[list[TrialSpec]]:
-    for i in range(0, len(specs), size):
-        yield list(specs[i:i + size])
-
-
-def _batch_group(spec: TrialSpec) -> tuple[Any, ...]:
-    """What the trials of one batch share (game.batch.run_trials): level, abstraction,
-    overrides, factors (and root seed and stimuli, which every trial of a design shares)."""
-    return (spec.level, spec.abstraction, spec.overrides, spec.factors, spec.root_seed,
-            spec.stimuli)
-
-
-def batch_tasks(specs: Sequence[TrialSpec], workers: int, max_batch: int
-                ) -> list[list[TrialSpec]]:
-    """The batch engine's tasks: ``specs`` grouped by level, abstraction, overrides and
-    factors (seeds, guard modes, player policies and scenarios vary inside a group), each
-    group cut into near-equal tasks of at most ``max_batch`` trials, and smaller ones when
-    there are fewer trials than ``max_batch`` x ``workers``, so every worker gets work.
-
-    Every spec is in exactly one task, in the sweep's order within its group; the tasks
-    take the groups in turn (the first task of each, then the second, ...), so an
-    interrupted sweep has run every group's first seeds.
-
-    >>> specs = [TrialSpec(level, seed=seed) for seed in range(3) for level in ("a", "b")]
-    >>> [[(s.level, s.seed) for s in task] for task in batch_tasks(specs, 1, 2)]
-    [[('a', 0), ('a', 1)], [('b', 0), ('b', 1)], [('a', 2)], [('b', 2)]]
-    """
-    if max_batch < 1 or workers < 1:
-        raise ValueError(f"batch_tasks: workers {workers} and max_batch {max_batch} must be >= 1")
-    groups: dict[tuple[Any, ...], list[TrialSpec]] = {}
-    for spec in specs:
-        groups.setdefault(_batch_group(spec), []).append(spec)
-    size = max(1, min(max_batch, math.ceil(len(specs) / workers)))
-    cut = []
-    for group in groups.values():
-        per = math.ceil(len(group) / math.ceil(len(group) / size))  # near-equal parts
-        cut.append([group[i:i + per] for i in range(0, len(group), per)])
-    return [parts[i] for i in range(max((len(p) for p in cut), default=0))
-            for parts in cut if i < len(parts)]
 
 
 def _pending(specs: list[TrialSpec], store_path: Path) -> list[TrialSpec]:
@@ -223,9 +179,8 @@ def run_sweep(
     store_path = out / STORE_NAME
     digests = level_digests(preset)
     _check_store(store_path, preset, digests)
-    batch = preset.engine == BATCH
-    if batch:  # before anything is written: a trial the engine does not cover is refused
-        check_covered(_pending(preset.specs(), store_path))
+    # before anything is written: the batch engine refuses a trial it does not cover
+    engines = split(_pending(preset.specs(), store_path), preset.engine)
     client: Any = None
     executor: cf.Executor | None = None
     lock: DirectoryLock | None = None
@@ -249,7 +204,7 @@ def run_sweep(
                          f"abstractions x {len(preset.guards)} guard modes x "
                          f"{len(preset.players)} player policies x {len(preset.scenarios)} "
                          f"scenarios{factors} x {len(preset.seeds)} seeds) -> {out}"
-                         f"{' (engine batch)' if batch else ''}\n")
+                         f" ({engines.describe()})\n")
         store = ResultStore(store_path)
         now = datetime.now(timezone.utc).isoformat(timespec="seconds")
         old_design = store.get_meta("design")
@@ -278,25 +233,20 @@ def run_sweep(
         if result.skipped and progress:
             stream.write(f"resuming: {result.skipped} of {len(specs)} trials already in "
                          f"{store_path}, {len(todo)} to run\n")
+        todo_keys = {s.key for s in todo}
+        engines.batch = [s for s in engines.batch if s.key in todo_keys]
+        engines.pymunk = [s for s in engines.pymunk if s.key in todo_keys]
         if progress:
-            _write_estimate(stream, preset, todo, parallelism)
+            _write_estimate(stream, preset, engines, parallelism)
         if executor is None:
             executor = process_pool(workers)
         inline = isinstance(executor, InlineExecutor)
         in_flight = 1 if inline else 2 * parallelism
-        task: Callable[..., list[dict[str, Any]]] = run_batch
-        if batch:
-            from game.batch import MAX_BATCH
-
-            task, tasks = run_engine_batch, iter(batch_tasks(todo, parallelism, MAX_BATCH))
-        else:
-            size = 1 if inline else max(1, min(_MAX_BATCH,
-                                               math.ceil(len(todo) / (parallelism * 8))))
-            tasks = _batches(todo, size)
+        tasks = engine_tasks(engines, parallelism, inline=inline)
         bar = Progress(len(todo), stream, enabled=progress)
         started = time.monotonic()
         try:
-            _drive(executor, tasks, in_flight, store, preset, result, bar, task)
+            _drive(executor, tasks, in_flight, store, preset, result, bar)
         finally:
             result.elapsed = time.monotonic() - started
             bar.close()
@@ -312,14 +262,18 @@ def run_sweep(
             lock.close()
 
 
-def _write_estimate(stream: IO[str], preset: Preset, todo: list[TrialSpec], workers: int
-                    ) -> None:
+def _write_estimate(stream: IO[str], preset: Preset, engines: Split, workers: int) -> None:
     """One line: the expected wall time of the trials to run (:mod:`headless.estimate`)."""
     names = dict(zip(preset.levels, preset.level_names))
-    seconds = estimate_seconds(((names.get(s.level, s.level), s.abstraction, s.scenario)
-                                for s in todo), workers,
-                               float(preset.config.get("world.duration", MEASURED_DURATION)))
-    stream.write(f"stealth: estimate: about {duration_text(seconds)} for {len(todo)} trials on "
+
+    def cells(specs: list[TrialSpec]) -> Iterator[tuple[str, str, str]]:
+        return ((names.get(s.level, s.level), s.abstraction, s.scenario) for s in specs)
+
+    seconds = estimate_seconds(cells(engines.pymunk), workers,
+                               float(preset.config.get("world.duration", MEASURED_DURATION)),
+                               cells(engines.batch))
+    count = len(engines.pymunk) + len(engines.batch)
+    stream.write(f"stealth: estimate: about {duration_text(seconds)} for {count} trials on "
                  f"{workers} worker{'s' if workers != 1 else ''} (per-trial times measured "
                  "on 2 vCPUs; the ETA below then uses the real rate)\n")
 
@@ -348,11 +302,13 @@ class _TaskError(Exception):
         self.error = error
 
 
-def _drive(executor: cf.Executor, batches: Iterator[list[TrialSpec]], in_flight: int,
-           store: ResultStore, preset: Preset, result: SweepResult, bar: Progress,
-           task: Callable[..., list[dict[str, Any]]] = run_batch) -> None:
-    """Keep at most ``in_flight`` tasks submitted (``task`` over each batch: ``run_batch``,
-    or ``run_engine_batch`` on the batch engine); commit every result as it arrives."""
+def _drive(executor: cf.Executor,
+           tasks: Iterator[tuple[Callable[..., list[dict[str, Any]]], list[TrialSpec]]],
+           in_flight: int, store: ResultStore, preset: Preset, result: SweepResult,
+           bar: Progress) -> None:
+    """Keep at most ``in_flight`` tasks submitted (each a function over its trials:
+    ``run_batch``, or ``run_engine_batch`` on the batch engine); commit every result as it
+    arrives."""
     pending: dict[cf.Future[Any], list[TrialSpec]] = {}
     names = dict(zip(preset.levels, preset.level_names))  # for the rows of failed trials
 
@@ -369,10 +325,11 @@ def _drive(executor: cf.Executor, batches: Iterator[list[TrialSpec]], in_flight:
         exhausted = False
         while True:
             while not exhausted and len(pending) < in_flight:
-                batch = next(batches, None)
-                if batch is None:
+                item = next(tasks, None)
+                if item is None:
                     exhausted = True
                     break
+                task, batch = item
                 pending[executor.submit(task, batch, names)] = batch
             if not pending:
                 break

@@ -37,8 +37,8 @@ from game.errors import ConfigError
 from game.trial import TrialSpec
 
 from ..errors import SweepError, UserError
-from ..executors import (InlineExecutor, connect_dask, process_pool, run_batch, shutdown,
-                        terminate)
+from ..engines import engine_tasks, split
+from ..executors import InlineExecutor, connect_dask, process_pool, shutdown, terminate
 from ..outputs.dirlock import DirectoryLock
 from .expr import ExpressionError
 from .objective import as_trials
@@ -49,13 +49,17 @@ __all__ = ["MAX_STUDY_TRIALS", "check_study_budget", "cmd_tune", "run_study"]
 
 STUDY_NAME = "stealth-tune"
 # --------------------------------------------------------------------------- evaluation
-def evaluate(executor: Any, specs: Sequence[TrialSpec], parallelism: int) -> list[dict[str, Any]]:
-    """Run ``specs`` over ``executor`` (batches of :func:`run_batch`) and return their rows
-    as trials; a failed trial raises :class:`SweepError`."""
-    size = max(1, min(8, math.ceil(len(specs) / (parallelism * 4))))
-    futures = [executor.submit(run_batch, list(specs[i:i + size]))
-               for i in range(0, len(specs), size)]
-    rows = [row for future in futures for row in future.result()]
+def evaluate(executor: Any, specs: Sequence[TrialSpec], parallelism: int,
+             engine: str = "auto") -> list[dict[str, Any]]:
+    """Run ``specs`` over ``executor`` on ``engine`` (``world.engine``: the batch engine's
+    groups and pymunk's small batches, :func:`headless.engines.engine_tasks`) and return
+    their rows as trials, in ``specs``' order; a failed trial raises :class:`SweepError`."""
+    tasks = engine_tasks(split(specs, engine), parallelism,
+                         inline=isinstance(executor, InlineExecutor))
+    futures = [executor.submit(task, part) for task, part in tasks]
+    order = {spec.key: i for i, spec in enumerate(specs)}
+    rows = sorted((row for future in futures for row in future.result()),
+                  key=lambda row: order[row["key"]])
     for row in rows:
         if row.get("error"):
             raise SweepError(f"trial {row['key']} failed: {row['error'].splitlines()[0]}")
@@ -135,7 +139,8 @@ def _run_study(optuna: Any, TrialState: Any, spec: TuneSpec, out: Path, trials: 
             trial = current.ask()
             values = {p.key: p.suggest(trial) for p in spec.params}
             try:
-                rows = evaluate(executor, spec.specs(values, seeds), parallelism)
+                rows = evaluate(executor, spec.specs(values, seeds), parallelism,
+                                spec.preset.engine)
             except BaseException:
                 current.tell(trial, state=TrialState.FAIL)
                 raise
@@ -167,7 +172,8 @@ def _run_study(optuna: Any, TrialState: Any, spec: TuneSpec, out: Path, trials: 
                 test = cached
             else:
                 held = range(spec.seeds_train, spec.seeds_train + spec.seeds_test)
-                rows = evaluate(executor, spec.specs(best.params, held), parallelism)
+                rows = evaluate(executor, spec.specs(best.params, held), parallelism,
+                                spec.preset.engine)
                 held_value, held_cons, held_facts = spec.score(rows)
                 test = {"trial": best.number, "value": held_value, "constraints": held_cons,
                         **held_facts}
