@@ -338,7 +338,8 @@ def test_ctrl_c_keeps_committed_trials_and_says_how_to_resume(
 
     monkeypatch.setattr(executors, "run_trial", interrupted)
     out = tmp_path / "out"
-    code = main(["run", "--preset", str(preset_path), "--out", str(out), "--workers", "1"])
+    code = main(["run", "--preset", str(preset_path), "--out", str(out), "--workers", "1",
+                 "--set", "world.engine=pymunk"])  # trial by trial: the 4th is interrupted
     assert code == 130
     err = capsys.readouterr().err
     assert "interrupted" in err and "resume with: stealth run --preset" in err
@@ -416,7 +417,8 @@ def test_a_dying_worker_stops_the_sweep_and_keeps_finished_trials(
 
     monkeypatch.setattr(executors, "run_trial", dies)
     out = tmp_path / "out"
-    assert main(["run", "--preset", str(preset_path), "--out", str(out), "--workers", "2"]) == 1
+    assert main(["run", "--preset", str(preset_path), "--out", str(out), "--workers", "2",
+                 "--set", "world.engine=pymunk"]) == 1  # trial by trial: seed 5's dies
     err = capsys.readouterr().err
     assert "a worker process died" in err and "resume with: stealth run" in err
     with ResultStore(out / "results.sqlite", readonly=True) as store:
