@@ -14,6 +14,7 @@ import pytest
 gymnasium = pytest.importorskip("gymnasium")
 pytest.importorskip("pettingzoo")
 
+from gymnasium.utils.env_checker import check_env  # noqa: E402
 from pettingzoo.test import api_test  # noqa: E402
 from pettingzoo.utils.wrappers import OrderEnforcingWrapper  # noqa: E402
 
@@ -21,10 +22,13 @@ from game.env import (  # noqa: E402
     ENV_ID,
     MAX_EPISODE_STEPS,
     PLAYER,
+    PLAYER_CHANNELS,
     STATE_FEATURES,
     STATE_GUARD,
     StealthEnv,
     StealthParallelEnv,
+    FlatObsWrapper,
+    ImgObsWrapper,
     env,
     parallel_env,
     raw_env,
@@ -172,3 +176,45 @@ def test_the_vector_entry_point_takes_the_step_limit() -> None:
                       StealthEnv)  # no TimeLimit around the world
     with pytest.raises(ValueError, match="max_episode_steps must be"):
         gymnasium.make_vec(ENV_ID, max_episode_steps=0, **kinds)
+
+
+@pytest.mark.parametrize("kind", ["dict", "image"])
+def test_dict_and_image_observations_pass_check_env(kind: str) -> None:
+    one = StealthEnv("maze", observation=kind, world__duration=6.0)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # a checker warning is a failure here
+        check_env(one, skip_render_check=True)
+
+
+def test_the_wrappers_give_back_the_flat_and_the_image_observations() -> None:
+    flat_env = StealthEnv("maze", obs_radius=3)
+    as_flat = FlatObsWrapper(StealthEnv("maze", obs_radius=3, observation="dict"))
+    as_image = ImgObsWrapper(StealthEnv("maze", obs_radius=3, observation="dict"))
+    image_env = StealthEnv("maze", obs_radius=3, observation="image")
+    assert as_flat.observation_space == flat_env.observation_space
+    assert as_image.observation_space == image_env.observation_space
+    assert image_env.observation_space.shape == (7, 7, len(PLAYER_CHANNELS))
+    envs = (flat_env, as_flat, as_image, image_env)
+    outs = [e.reset(seed=3)[0] for e in envs]
+    rng = np.random.default_rng(2)
+    for _ in range(30):
+        flat, wrapped, img_w, img = outs
+        assert np.array_equal(flat, wrapped) and wrapped.dtype == np.float32
+        assert np.array_equal(img_w, img) and as_image.observation_space.contains(img)
+        # the image is the flat window, channel-last: the player's own cell at the centre
+        window = flat[:7 * 7 * len(PLAYER_CHANNELS)].reshape(len(PLAYER_CHANNELS), 7, 7)
+        assert np.array_equal(img, window.transpose(1, 2, 0))
+        assert img[3, 3, PLAYER_CHANNELS.index("player")] == 1.0
+        action = int(rng.integers(5))
+        steps = [e.step(action) for e in envs]
+        outs = [s[0] for s in steps]
+        assert len({(s[1], s[2], s[3]) for s in steps}) == 1  # the same play
+        if steps[0][2] or steps[0][3]:
+            break
+    made = gymnasium.make(ENV_ID, level="maze", observation="dict")
+    obs, _ = made.reset(seed=0)
+    assert made.observation_space.contains(obs) and set(obs) == {"image", "features"}
+    with pytest.raises(ValueError, match="unknown observation 'rgb'.*flat, dict, image"):
+        StealthEnv("maze", observation="rgb")
+    with pytest.raises(ValueError, match="observation='dict'"):
+        ImgObsWrapper(StealthEnv("maze"))

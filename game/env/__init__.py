@@ -54,6 +54,7 @@ from .match import (  # re-exported: the env API names them
     ExternalPlayer,
     Match,
 )
+from .wrappers import OBSERVATIONS, FlatObsWrapper, ImgObsWrapper, Layout
 from .observations import (  # re-exported: the layout's names (docs/api.md)
     OBS_BOUND,
     STATE_FEATURES,
@@ -308,8 +309,9 @@ def env(level: str = "miami", abstraction: str = "grid", scenario: str = "captur
 class StealthEnv(gymnasium.Env):
     """The player against AI guards (``guards``: pf, random, fsm, staleness, cheat).
 
-    Same observations, actions, step and rewards as the ``"player"`` agent of
-    :func:`parallel_env`; options as there.
+    Same observations, actions, step and rewards as the ``"player_0"`` agent of
+    :func:`parallel_env`; options as there, and ``observation``: ``"flat"`` (the default),
+    ``"dict"`` or ``"image"`` (:mod:`game.env.wrappers`).
 
     >>> env = StealthEnv("maze", guards="pf")
     >>> obs, info = env.reset(seed=3)
@@ -320,29 +322,42 @@ class StealthEnv(gymnasium.Env):
     metadata = {"render_modes": ["rgb_array", "human"], "render_fps": 4}
 
     def __init__(self, level: str = "miami", guards: str = DEFAULT_GUARD_MODE,
-                 abstraction: str = "grid", scenario: str = "capture", **config: Any) -> None:
+                 abstraction: str = "grid", scenario: str = "capture",
+                 observation: str = "flat", **config: Any) -> None:
+        if observation not in OBSERVATIONS:
+            raise ValueError(f"unknown observation {observation!r} "
+                             f"(choose from {', '.join(OBSERVATIONS)})")
         options, overrides = _split_options(level, abstraction, scenario, config)
         self.match = Match(level, abstraction, scenario, guards, overrides, **options)
         self.render_mode = self.match.render_mode
-        self.observation_space = self.match.obs_space(False)
+        observer = self.match.observer
+        side = 2 * observer.radius + 1
+        window = len(PLAYER_CHANNELS) * side * side
+        #: ``"flat"``, ``"dict"`` or ``"image"`` (game.env.wrappers)
+        self.observation = observation
+        self._layout = Layout(len(PLAYER_CHANNELS), side, observer.obs_size(False) - window)
+        self.observation_space = self._layout.space(observation)
         self._actions = spaces.Discrete(self.match.n_actions)
         self.action_space = self._actions
 
+    def _observe(self) -> Any:
+        return self._layout.convert(self.match.observe_player(), self.observation)
+
     def reset(self, *, seed: int | None = None, options: dict | None = None
-              ) -> tuple[np.ndarray, dict[str, Any]]:
+              ) -> tuple[Any, dict[str, Any]]:
         super().reset(seed=seed)
         info = self.match.reset(seed, self.np_random)
-        return self.match.observe_player(), info
+        return self._observe(), info
 
     def action_masks(self) -> np.ndarray:
         """Which actions move the player now (sb3-contrib's ``MaskablePPO`` reads this)."""
         return self.match.action_mask()
 
-    def step(self, action: Any) -> tuple[np.ndarray, float, bool, bool, dict[str, Any]]:
+    def step(self, action: Any) -> tuple[Any, float, bool, bool, dict[str, Any]]:
         """One player move; an action outside ``action_space`` is a ValueError naming it."""
         action = check_action(self._actions, action, "the player")
         reward, terminated, truncated = self.match.step(action)
-        obs = self.match.observe_player()
+        obs = self._observe()
         if self.render_mode == "human":
             self.match.render()
         return obs, reward, terminated, truncated, self.match.info()
@@ -408,6 +423,7 @@ if ENV_ID not in gymnasium.registry:
 __all__ = ["ENV_ID", "GRID_ACTIONS", "GUARD_CHANNELS", "GUARD_FEATURES", "MAX_EPISODE_STEPS",
            "MOVE_FEATURES", "OLD_PLAYER", "OTHER_GUARD", "PARTITION_ACTIONS", "PLAYER",
            "PLAYER_AS_SEEN", "PLAYER_CHANNELS", "PLAYER_FEATURES", "PLAYER_GUARD", "REWARDS",
-           "STATE_FEATURES", "STATE_GUARD", "AgentDict", "ExternalGuards", "ExternalPlayer",
+           "OBSERVATIONS", "STATE_FEATURES", "STATE_GUARD", "AgentDict", "FlatObsWrapper",
+           "ImgObsWrapper", "ExternalGuards", "ExternalPlayer",
            "StealthEnv", "StealthParallelEnv", "StealthVectorEnv", "agent_name", "check_action",
            "env", "parallel_env", "raw_env"]
