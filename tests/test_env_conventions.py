@@ -116,19 +116,22 @@ def test_the_old_player_name_still_works_with_a_deprecation_warning() -> None:
     new, old = parallel_env("maze", world__guards=2), parallel_env("maze", world__guards=2)
     new.reset(seed=5)
     obs_old, _ = old.reset(seed=5)
-    with pytest.warns(DeprecationWarning, match="'player' is deprecated.*'player_0'"):
+    with pytest.warns(DeprecationWarning, match="'player' is deprecated.*'player_0'") as caught:
         first = obs_old["player"]
+    assert caught[0].filename == __file__  # the warning points at the caller's line
     assert first is obs_old[PLAYER]
     assert "player" not in obs_old and set(obs_old) == set(old.agents)  # no extra agent
     for action in (2, 3, 0, 4):
         a = new.step({PLAYER: action, "guard_0": 1})
-        with pytest.warns(DeprecationWarning):
+        with pytest.warns(DeprecationWarning) as caught:
             b = old.step({"player": action, "guard_0": 1})
+        assert [w.filename for w in caught] == [__file__]
         assert np.array_equal(a[0][PLAYER], b[0][PLAYER]) and a[1] == b[1]
         with pytest.warns(DeprecationWarning):
             assert b[1]["player"] == a[1][PLAYER]
-    with pytest.warns(DeprecationWarning):
+    with pytest.warns(DeprecationWarning) as caught:
         assert old.observation_space("player") is old.observation_space(PLAYER)
+    assert caught[0].filename == __file__
     with pytest.warns(DeprecationWarning):
         assert old.action_space("player") is old.action_space(PLAYER)
     with pytest.warns(DeprecationWarning):

@@ -54,11 +54,7 @@ from .match import (  # re-exported: the env API names them
     ExternalPlayer,
     Match,
 )
-from .wrappers import OBSERVATIONS, FlatObsWrapper, ImgObsWrapper, Layout
 from .observations import (  # re-exported: the layout's names (docs/api.md)
-    OBS_BOUND,
-    STATE_FEATURES,
-    STATE_GUARD,
     GUARD_CHANNELS,
     GUARD_FEATURES,
     MOVE_FEATURES,
@@ -67,7 +63,11 @@ from .observations import (  # re-exported: the layout's names (docs/api.md)
     PLAYER_CHANNELS,
     PLAYER_FEATURES,
     PLAYER_GUARD,
+    STATE_FEATURES,
+    STATE_GUARD,
 )
+from .observations import OBS_BOUND
+from .wrappers import OBSERVATIONS, FlatObsWrapper, ImgObsWrapper, Layout
 
 ENV_ID = "stealthfield/Stealth-v0"
 #: Keyword options of the environments; every other keyword is a config override.
@@ -240,7 +240,8 @@ class StealthParallelEnv(ParallelEnv):
             if PLAYER in actions:
                 raise ValueError(f"actions for both {OLD_PLAYER!r} and {PLAYER!r}: "
                                  f"they are one agent (use {PLAYER!r})")
-            actions = {agent_name(a): act for a, act in actions.items()}
+            _old_name_warning(2)
+            actions = {PLAYER if a == OLD_PLAYER else a: act for a, act in actions.items()}
         chosen = {a: check_action(self._act_spaces[a], act, repr(a)) for a, act in actions.items()}
         guard_actions = np.array([chosen.get(f"guard_{i}", 0)
                                   for i in range(self.match.n_guards)], dtype=np.int64)
