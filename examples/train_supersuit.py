@@ -28,7 +28,7 @@ from collections.abc import Callable
 
 import numpy as np
 
-from game.env import StealthParallelEnv, parallel_env
+from game.env import PLAYER, StealthParallelEnv, parallel_env
 from train_ppo import paired  # beside this file
 
 Policy = Callable[[np.ndarray, np.random.Generator], int]
@@ -44,12 +44,12 @@ def play_sides(env: StealthParallelEnv, player: Policy, guards: Policy,
         obs, infos = env.reset(seed=seed)
         total = 0.0
         while env.agents:
-            actions = {a: player(obs[a], player_rng) if a == "player" else guards(obs[a], guard_rng)
+            actions = {a: player(obs[a], player_rng) if a == PLAYER else guards(obs[a], guard_rng)
                        for a in env.agents}
             obs, rewards, _, _, infos = env.step(actions)
-            total += rewards["player"]
-        out["survival"].append(infos["player"]["t"])
-        out["captured"].append(float(infos["player"]["captures"] > 0))
+            total += rewards[PLAYER]
+        out["survival"].append(infos[PLAYER]["t"])
+        out["captured"].append(float(infos[PLAYER]["captures"] > 0))
         out["return"].append(total)
     return {k: np.asarray(v) for k, v in out.items()}
 
@@ -78,7 +78,7 @@ def main() -> None:
     train_s = time.perf_counter() - start
 
     env = parallel_env(args.level, rewards={"seen": 0.0, "proximity": 0.0})
-    n = int(env.action_space("player").n)
+    n = int(env.action_space(PLAYER).n)
     seeds = range(args.test_seeds)
     sides: dict[str, Policy] = {
         "policy": lambda obs, rng: int(model.predict(obs, deterministic=True)[0]),

@@ -18,7 +18,11 @@
 
 Every finished trial is committed at once, so a sweep killed at any moment loses at most
 the trials still running. Only the sweep's main process writes; readers (``stealth
-report``, a notebook) may read while it runs.
+report``, a notebook) may read while it runs: the WAL journal lets them. Closing the writer
+checkpoints the journal and returns the file to SQLite's ``DELETE`` journal, which removes
+``results.sqlite-wal`` and ``-shm``: a finished store is one file, and a reader of it
+creates no journal files (a store left in WAL mode — a killed sweep, or one written before
+issue 41 — keeps them until the next writer on it closes).
 
 >>> import tempfile, pathlib
 >>> with ResultStore(pathlib.Path(tempfile.mkdtemp()) / "results.sqlite") as store:
@@ -160,8 +164,12 @@ class ResultStore:
     Open it with ``ResultStore(path)``; ``readonly=True`` never creates or changes the file.
     """
 
+    #: how long closing waits for readers to let go before it leaves the store in WAL mode
+    CLOSE_WAIT_MS = 2000
+
     def __init__(self, path: str | Path, *, readonly: bool = False) -> None:
         self.path = Path(path)
+        self.readonly = readonly
         #: the metrics registered when the store was opened: its metric columns
         self.metrics: tuple[Metric, ...] = registered_metrics()
         if readonly:
@@ -207,7 +215,19 @@ class ResultStore:
         self.close()
 
     def close(self) -> None:
-        """Close the connection (everything written is already committed)."""
+        """Close the connection (everything written is already committed).
+
+        A writer first leaves WAL mode (a checkpoint, then SQLite deletes ``-wal`` and
+        ``-shm``), so no journal file stays beside a finished store; while another
+        connection still has the file open that fails after :attr:`CLOSE_WAIT_MS` and the
+        store stays in WAL mode, intact, its journal files kept for that reader.
+        """
+        if not self.readonly:
+            try:
+                self.db.execute(f"PRAGMA busy_timeout = {self.CLOSE_WAIT_MS}")
+                self.db.execute("PRAGMA journal_mode = DELETE")
+            except sqlite3.Error:
+                pass
         self.db.close()
 
     # ------------------------------------------------------------------ meta

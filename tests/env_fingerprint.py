@@ -24,6 +24,8 @@ REFERENCE = Path(__file__).parent / "data" / "env_fingerprint.json"
 #: the reward terms in force when the reference was recorded (the defaults changed since:
 #: the fingerprint pins the simulation, so it keeps the terms it was recorded with)
 RECORDED_REWARDS = {"survival": 0.1, "hp": 1.0, "capture": 10.0, "seen": 2.0, "proximity": 6.0}
+#: agent names as they were recorded (the player became "player_0" in issue 41)
+_RECORDED_NAMES = {"player_0": "player"}
 #: (name, builder kind, level, abstraction, steps)
 CASES = (("gym-miami-grid", "gym", "miami", "grid", 400),
          ("gym-miami-partition", "gym", "miami", "partition", 250),
@@ -40,8 +42,11 @@ def _digest(*parts: Any) -> str:
             h.update(struct.pack("<d", part))
         elif isinstance(part, dict):
             for key in sorted(part):
-                h.update(key.encode())
-                h.update(_digest(part[key]).encode())
+                value = part[key]
+                if key == "action_mask":  # hashed as the values it was recorded with (bool
+                    value = np.asarray(value).astype(bool)  # then; int8 now, issue 41)
+                h.update(_RECORDED_NAMES.get(key, key).encode())
+                h.update(_digest(value).encode())
         else:
             h.update(repr(part).encode())
     return h.hexdigest()[:16]
@@ -68,7 +73,7 @@ def play(kind: str, level: str, abstraction: str, steps: int) -> list[str]:
     penv = parallel_env(level, abstraction, rewards=RECORDED_REWARDS)
     pobs, infos = penv.reset(seed=7)
     out.append(_digest(pobs, infos))
-    m = int(penv.action_space("player").n)
+    m = int(penv.action_space("player_0").n)
     for _ in range(steps):
         actions = {a: int(rng.integers(m)) for a in penv.agents}
         pobs, rewards, terms, truncs, infos = penv.step(actions)

@@ -54,10 +54,10 @@ def test_spaces_follow_the_abstraction() -> None:
     assert StealthEnv("maze").action_space.n == 5
     assert StealthEnv("maze", abstraction="partition").action_space.n == 9
     env = parallel_env("maze", world__guards=2, obs_radius=2, pad_observations=False)
-    assert env.possible_agents == ["player", "guard_0", "guard_1"]
+    assert env.possible_agents == ["player_0", "guard_0", "guard_1"]
     # player: 3 channels of 5x5, 7 own features, 7 per guard, 2 per action;
     # guards: 5 channels, 7, 5 per guard, 3
-    assert env.observation_space("player").shape == (3 * 25 + 7 + 2 * 7 + 5 * 2,)
+    assert env.observation_space("player_0").shape == (3 * 25 + 7 + 2 * 7 + 5 * 2,)
     assert env.observation_space("guard_1").shape == (5 * 25 + 7 + 2 * 5 + 3,)
     padded = parallel_env("maze", world__guards=2, obs_radius=2)  # the default: one size
     assert all(padded.observation_space(a) == env.observation_space("guard_1")
@@ -65,8 +65,8 @@ def test_spaces_follow_the_abstraction() -> None:
     obs, _ = padded.reset(seed=0)
     own = StealthEnv("maze", world__guards=2, obs_radius=2)
     first, _ = own.reset(seed=0)
-    assert np.array_equal(obs["player"][:len(first)], first)  # the player's layout, then zeros
-    assert not obs["player"][len(first):].any()
+    assert np.array_equal(obs["player_0"][:len(first)], first)  # the player's layout, then zeros
+    assert not obs["player_0"][len(first):].any()
 
 
 def _rollout(env: StealthEnv, seed: int, actions: np.ndarray) -> tuple[list, list]:
@@ -153,12 +153,12 @@ def test_guard_agents_move_as_told_and_see_fields() -> None:
     moves = env.match.moves
     guard_nodes = [g.node for g in world.guards]
     # the guards decide at their first arrival, which is the first physics step
-    env.step({"player": 0, "guard_0": 2, "guard_1": 3})
+    env.step({"player_0": 0, "guard_0": 2, "guard_1": 3})
     targets = [g.target for g in world.guards]
     assert targets == [moves[guard_nodes[0], 2], moves[guard_nodes[1], 3]]
     for _ in range(6):
-        obs, rewards, *_ = env.step({"player": 0, "guard_0": 1, "guard_1": 4})
-        assert rewards["guard_0"] == -rewards["player"]
+        obs, rewards, *_ = env.step({"player_0": 0, "guard_0": 1, "guard_1": 4})
+        assert rewards["guard_0"] == -rewards["player_0"]
     side = (2 * env.match.observer.radius + 1) ** 2
     confidence = obs["guard_0"][4 * side:5 * side]
     assert confidence.max() > 0  # the team's confidence field is observed
@@ -224,10 +224,10 @@ def test_parallel_env_refuses_unknown_agents_and_bad_actions() -> None:
     env = parallel_env("maze", world__guards=2)
     env.reset(seed=0)
     with pytest.raises(ValueError, match="unknown agent.*guard_7"):
-        env.step({"player": 0, "guard_7": 1})
+        env.step({"player_0": 0, "guard_7": 1})
     with pytest.raises(ValueError, match="invalid action -1 for 'guard_0'"):
-        env.step({"player": 0, "guard_0": -1})
-    env.step({"player": 1, "guard_0": 2})
+        env.step({"player_0": 0, "guard_0": -1})
+    env.step({"player_0": 1, "guard_0": 2})
 
 
 def test_action_masks_say_which_actions_move() -> None:
@@ -322,7 +322,7 @@ def test_supersuit_vectorises_the_parallel_env_as_it_is() -> None:
     venv = supersuit.concat_vec_envs_v1(supersuit.pettingzoo_env_to_vec_env_v1(env), 2,
                                         num_cpus=0, base_class="gymnasium")
     obs, _ = venv.reset(seed=0)
-    assert venv.num_envs == 6 and obs.shape == (6, *env.observation_space("player").shape)
+    assert venv.num_envs == 6 and obs.shape == (6, *env.observation_space("player_0").shape)
     for _ in range(15):
         obs, rewards, *_ = venv.step(np.zeros(6, dtype=np.int64))
     assert rewards.shape == (6,)

@@ -45,7 +45,7 @@ def test_booleans_are_not_actions(action: object) -> None:
     penv = parallel_env("maze", world__guards=1)
     penv.reset(seed=0)
     with pytest.raises(ValueError, match="invalid action .* for 'guard_0'"):
-        penv.step({"player": 0, "guard_0": action})
+        penv.step({"player_0": 0, "guard_0": action})
 
 
 @pytest.mark.parametrize("weight", [math.nan, math.inf, -math.inf, "1", None, True, 1e308, -2e6])

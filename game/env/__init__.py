@@ -1,7 +1,9 @@
 """Reinforcement-learning environments over the simulated world (SPEC §10, docs/api.md).
 
 * :func:`parallel_env` — a PettingZoo ``ParallelEnv``: the player and every guard are agents
-  (``"player"``, ``"guard_0"``, ``"guard_1"``, ...).
+  (``"player_0"``, ``"guard_0"``, ``"guard_1"``, ...; the old name ``"player"`` is still
+  read, with a DeprecationWarning, until 0.3); :func:`env` / :func:`raw_env` — the same as
+  PettingZoo's AEC env (agents act in turn).
 * :class:`StealthEnv` — a Gymnasium ``Env``: the agent is the player, the guards run one of
   the project's guard AIs (``pf``, ``fsm``, ...). Registered as ``"stealthfield/Stealth-v0"``
   when this module is imported.
@@ -24,6 +26,7 @@ Observations: :mod:`game.env.observations`; the match (world, controllers, rewar
 
 from __future__ import annotations
 
+import warnings
 from collections.abc import Mapping
 from typing import Any
 
@@ -32,7 +35,9 @@ import numpy as np
 try:
     import gymnasium
     from gymnasium import spaces
-    from pettingzoo import ParallelEnv
+    from pettingzoo import AECEnv, ParallelEnv
+    from pettingzoo.utils.conversions import parallel_to_aec_wrapper
+    from pettingzoo.utils.wrappers import OrderEnforcingWrapper
 except ImportError as error:  # pragma: no cover - depends on the installation
     raise ImportError(
         f"game.env needs gymnasium and pettingzoo ({error.name} is missing): "
@@ -58,7 +63,11 @@ from .observations import (  # re-exported: the layout's names (docs/api.md)
     PLAYER_CHANNELS,
     PLAYER_FEATURES,
     PLAYER_GUARD,
+    STATE_FEATURES,
+    STATE_GUARD,
 )
+from .observations import OBS_BOUND
+from .wrappers import OBSERVATIONS, FlatObsWrapper, ImgObsWrapper, Layout
 
 ENV_ID = "stealthfield/Stealth-v0"
 #: Keyword options of the environments; every other keyword is a config override.
@@ -104,6 +113,38 @@ def _split_options(level: str, abstraction: str, scenario: str, kwargs: dict[str
 
 # ---------------------------------------------------------------------------- PettingZoo
 
+#: The player's agent name, in PettingZoo's ``<kind>_<index>`` style.
+PLAYER = "player_0"
+#: The player's name until issue 41; still accepted, with a DeprecationWarning, until 0.3.
+OLD_PLAYER = "player"
+
+
+def _old_name_warning(stacklevel: int) -> None:
+    warnings.warn(f"the agent name {OLD_PLAYER!r} is deprecated and will be removed in 0.3: "
+                  f"use {PLAYER!r}", DeprecationWarning, stacklevel=stacklevel + 1)
+
+
+def agent_name(agent: Any, stacklevel: int = 2) -> Any:
+    """``agent`` with the deprecated ``"player"`` read as ``"player_0"`` (and a warning)."""
+    if agent == OLD_PLAYER:
+        _old_name_warning(stacklevel + 1)
+        return PLAYER
+    return agent
+
+
+class AgentDict(dict[str, Any]):
+    """A dict keyed by agent names in which ``d["player"]`` still finds ``d["player_0"]``.
+
+    Only lookup by the old name is forwarded (with a DeprecationWarning); keys, iteration,
+    ``in`` and ``get`` see the new names alone, so PettingZoo's checks see no extra agent.
+    """
+
+    def __missing__(self, key: str) -> Any:
+        if key == OLD_PLAYER and PLAYER in self:
+            _old_name_warning(2)
+            return self[PLAYER]
+        raise KeyError(key)
+
 
 class StealthParallelEnv(ParallelEnv):
     """Player and guards as PettingZoo agents in one trial (see :func:`parallel_env`)."""
@@ -119,14 +160,17 @@ class StealthParallelEnv(ParallelEnv):
         options, overrides = _split_options(level, abstraction, scenario, config)
         self.match = Match(level, abstraction, scenario, None, overrides, **options)
         self.render_mode = self.match.render_mode
-        self.possible_agents = ["player"] + [f"guard_{i}" for i in range(self.match.n_guards)]
+        self.possible_agents = [PLAYER] + [f"guard_{i}" for i in range(self.match.n_guards)]
         self.agents: list[str] = []
-        sizes = {a: self.match.observer.obs_size(a != "player") for a in self.possible_agents}
+        sizes = {a: self.match.observer.obs_size(a != PLAYER) for a in self.possible_agents}
         #: every agent's observation length: the largest one when padding (the default)
         self._sizes = dict.fromkeys(sizes, max(sizes.values())) if pad_observations else sizes
-        self._obs_spaces = {a: self.match.obs_space(a != "player", self._sizes[a])
+        self._obs_spaces = {a: self.match.obs_space(a != PLAYER, self._sizes[a])
                             for a in self.possible_agents}
         self._act_spaces = {a: spaces.Discrete(self.match.n_actions) for a in self.possible_agents}
+        #: the global state's space (:meth:`state`): everyone's true position and status
+        self.state_space = spaces.Box(-OBS_BOUND, OBS_BOUND,
+                                      shape=(self.match.observer.state_size(),), dtype=np.float32)
         #: where the first seedless reset's seed comes from; made at the first reset, not
         #: here, so that copies of a new env (SuperSuit's vector wrappers pickle one per
         #: copy, then SB3 resets them seedless) draw seeds of their own: copies of one
@@ -134,14 +178,19 @@ class StealthParallelEnv(ParallelEnv):
         self._fallback: np.random.Generator | None = None
 
     def observation_space(self, agent: str) -> spaces.Box:
-        return self._obs_spaces[agent]
+        return self._obs_spaces[agent_name(agent)]
 
     def action_space(self, agent: str) -> spaces.Discrete:
-        return self._act_spaces[agent]
+        return self._act_spaces[agent_name(agent)]
 
-    def _observe(self) -> dict[str, np.ndarray]:
+    def state(self) -> np.ndarray:
+        """The global state now (layout: docs/api.md, "State"): what a centralised critic
+        reads, the true positions of everyone whatever each agent perceives."""
+        return self.match.observer.state(self.match.world, self.match.world.view())
+
+    def _observe(self) -> AgentDict:
         view = self.match.world.view()
-        obs = {"player": self.match.observe_player()}
+        obs = AgentDict({PLAYER: self.match.observe_player()})
         for i in range(self.match.n_guards):
             obs[f"guard_{i}"] = self.match.observe_guard(view, i)
         for agent, o in obs.items():
@@ -149,21 +198,22 @@ class StealthParallelEnv(ParallelEnv):
                 obs[agent] = np.concatenate([o, np.zeros(self._sizes[agent] - len(o), np.float32)])
         return obs
 
-    def _infos(self) -> dict[str, dict]:
+    def _infos(self) -> AgentDict:
         info = self.match.info()
-        infos = {"player": info}
+        infos = {PLAYER: info}
         for i, guard in enumerate(self.match.world.guards):
             infos[f"guard_{i}"] = {**info, "action_mask": self.match.action_mask(guard.node)}
-        return {a: infos[a] for a in self.agents}
+        return AgentDict({a: infos[a] for a in self.agents})
 
     def action_masks(self, agent: str) -> np.ndarray:
         """``agent``'s action mask now (as its ``info["action_mask"]``)."""
-        if agent == "player":
+        agent = agent_name(agent)
+        if agent == PLAYER:
             return self.match.action_mask()
         return self.match.action_mask(self.match.world.guards[self._guard_index(agent)].node)
 
     def _guard_index(self, agent: str) -> int:
-        if agent not in self.possible_agents or agent == "player":
+        if agent not in self.possible_agents or agent == PLAYER:
             raise ValueError(f"unknown agent {agent!r} (agents: {self.possible_agents})")
         return self.possible_agents.index(agent) - 1
 
@@ -178,21 +228,28 @@ class StealthParallelEnv(ParallelEnv):
     def step(self, actions: Mapping[str, Any]) -> tuple[dict, dict, dict, dict, dict]:
         """Missing actions mean "stay"; guard rewards are the negated player reward.
 
-        An unknown agent or an action outside the agent's space is a ValueError naming it.
+        An unknown agent or an action outside the agent's space is a ValueError naming it;
+        the deprecated name ``"player"`` is read as ``"player_0"`` (twice is an error).
         """
         if not self.agents:
             raise RuntimeError("step() after the episode ended: call reset()")
-        unknown = [a for a in actions if a not in self.agents]
+        unknown = [a for a in actions if a not in self.agents and a != OLD_PLAYER]
         if unknown:
             raise ValueError(f"unknown agent(s) {unknown} (agents: {self.agents})")
+        if OLD_PLAYER in actions:
+            if PLAYER in actions:
+                raise ValueError(f"actions for both {OLD_PLAYER!r} and {PLAYER!r}: "
+                                 f"they are one agent (use {PLAYER!r})")
+            _old_name_warning(2)
+            actions = {PLAYER if a == OLD_PLAYER else a: act for a, act in actions.items()}
         chosen = {a: check_action(self._act_spaces[a], act, repr(a)) for a, act in actions.items()}
         guard_actions = np.array([chosen.get(f"guard_{i}", 0)
                                   for i in range(self.match.n_guards)], dtype=np.int64)
-        reward, terminated, truncated = self.match.step(chosen.get("player", 0), guard_actions)
+        reward, terminated, truncated = self.match.step(chosen.get(PLAYER, 0), guard_actions)
         obs = self._observe()
-        rewards = {a: (reward if a == "player" else -reward) for a in self.agents}
-        terms = dict.fromkeys(self.agents, terminated)
-        truncs = dict.fromkeys(self.agents, truncated)
+        rewards = AgentDict({a: (reward if a == PLAYER else -reward) for a in self.agents})
+        terms = AgentDict(dict.fromkeys(self.agents, terminated))
+        truncs = AgentDict(dict.fromkeys(self.agents, truncated))
         infos = self._infos()
         if terminated or truncated:
             self.agents = []
@@ -209,7 +266,7 @@ class StealthParallelEnv(ParallelEnv):
 
 def parallel_env(level: str = "miami", abstraction: str = "grid", scenario: str = "capture",
                  pad_observations: bool = True, **config: Any) -> StealthParallelEnv:
-    """A PettingZoo ``ParallelEnv`` of one level: agents ``"player"``, ``"guard_0"``, ...
+    """A PettingZoo ``ParallelEnv`` of one level: agents ``"player_0"``, ``"guard_0"``, ...
 
     Every agent's observation has the same length (the guards', the longest; the player's
     is padded with zeros) so that SuperSuit's vector wrappers take the env as it is;
@@ -222,9 +279,29 @@ def parallel_env(level: str = "miami", abstraction: str = "grid", scenario: str 
 
     >>> env = parallel_env("maze", world__guards=2)
     >>> env.possible_agents
-    ['player', 'guard_0', 'guard_1']
+    ['player_0', 'guard_0', 'guard_1']
     """
     return StealthParallelEnv(level, abstraction, scenario, pad_observations, **config)
+
+
+def raw_env(level: str = "miami", abstraction: str = "grid", scenario: str = "capture",
+            pad_observations: bool = True, **config: Any) -> AECEnv:
+    """The PettingZoo AEC env of :func:`parallel_env` without wrappers: agents act in turn
+    (``player_0``, ``guard_0``, ...) and the world plays the move once the last has acted.
+
+    >>> aec = raw_env("maze", world__guards=2)
+    >>> aec.reset(seed=0); aec.agent_selection
+    'player_0'
+    """
+    return parallel_to_aec_wrapper(parallel_env(level, abstraction, scenario, pad_observations,
+                                                **config))
+
+
+def env(level: str = "miami", abstraction: str = "grid", scenario: str = "capture",
+        pad_observations: bool = True, **config: Any) -> AECEnv:
+    """:func:`raw_env` with PettingZoo's ``OrderEnforcingWrapper`` (what its ``env()`` gives)."""
+    return OrderEnforcingWrapper(raw_env(level, abstraction, scenario, pad_observations,
+                                         **config))
 
 
 # ---------------------------------------------------------------------------- Gymnasium
@@ -233,8 +310,9 @@ def parallel_env(level: str = "miami", abstraction: str = "grid", scenario: str 
 class StealthEnv(gymnasium.Env):
     """The player against AI guards (``guards``: pf, random, fsm, staleness, cheat).
 
-    Same observations, actions, step and rewards as the ``"player"`` agent of
-    :func:`parallel_env`; options as there.
+    Same observations, actions, step and rewards as the ``"player_0"`` agent of
+    :func:`parallel_env`; options as there, and ``observation``: ``"flat"`` (the default),
+    ``"dict"`` or ``"image"`` (:mod:`game.env.wrappers`).
 
     >>> env = StealthEnv("maze", guards="pf")
     >>> obs, info = env.reset(seed=3)
@@ -245,29 +323,42 @@ class StealthEnv(gymnasium.Env):
     metadata = {"render_modes": ["rgb_array", "human"], "render_fps": 4}
 
     def __init__(self, level: str = "miami", guards: str = DEFAULT_GUARD_MODE,
-                 abstraction: str = "grid", scenario: str = "capture", **config: Any) -> None:
+                 abstraction: str = "grid", scenario: str = "capture",
+                 observation: str = "flat", **config: Any) -> None:
+        if observation not in OBSERVATIONS:
+            raise ValueError(f"unknown observation {observation!r} "
+                             f"(choose from {', '.join(OBSERVATIONS)})")
         options, overrides = _split_options(level, abstraction, scenario, config)
         self.match = Match(level, abstraction, scenario, guards, overrides, **options)
         self.render_mode = self.match.render_mode
-        self.observation_space = self.match.obs_space(False)
+        observer = self.match.observer
+        side = 2 * observer.radius + 1
+        window = len(PLAYER_CHANNELS) * side * side
+        #: ``"flat"``, ``"dict"`` or ``"image"`` (game.env.wrappers)
+        self.observation = observation
+        self._layout = Layout(len(PLAYER_CHANNELS), side, observer.obs_size(False) - window)
+        self.observation_space = self._layout.space(observation)
         self._actions = spaces.Discrete(self.match.n_actions)
         self.action_space = self._actions
 
+    def _observe(self) -> Any:
+        return self._layout.convert(self.match.observe_player(), self.observation)
+
     def reset(self, *, seed: int | None = None, options: dict | None = None
-              ) -> tuple[np.ndarray, dict[str, Any]]:
+              ) -> tuple[Any, dict[str, Any]]:
         super().reset(seed=seed)
         info = self.match.reset(seed, self.np_random)
-        return self.match.observe_player(), info
+        return self._observe(), info
 
     def action_masks(self) -> np.ndarray:
         """Which actions move the player now (sb3-contrib's ``MaskablePPO`` reads this)."""
         return self.match.action_mask()
 
-    def step(self, action: Any) -> tuple[np.ndarray, float, bool, bool, dict[str, Any]]:
+    def step(self, action: Any) -> tuple[Any, float, bool, bool, dict[str, Any]]:
         """One player move; an action outside ``action_space`` is a ValueError naming it."""
         action = check_action(self._actions, action, "the player")
         reward, terminated, truncated = self.match.step(action)
-        obs = self.match.observe_player()
+        obs = self._observe()
         if self.render_mode == "human":
             self.match.render()
         return obs, reward, terminated, truncated, self.match.info()
@@ -291,25 +382,49 @@ class StealthVectorEnv(gymnasium.vector.SyncVectorEnv):
     vectorization_mode="vector_entry_point", level=...)`` builds: the worlds share the
     level, its graph and its move table (cached per process), so n worlds cost one level's
     set-up; ``reset(seed=s)`` plays seeds ``s, s + 1, ...``; ``action_masks()`` stacks the
-    worlds' masks (n, actions).
+    worlds' masks (n, actions). ``max_episode_steps`` (which ``make_vec`` passes: the
+    registered :data:`MAX_EPISODE_STEPS` unless given) wraps every world in ``TimeLimit``
+    as ``gymnasium.make`` does; ``None`` or ``-1``: no limit but the env's own clock.
     """
 
-    def __init__(self, num_envs: int = 1, **kwargs: Any) -> None:
+    def __init__(self, num_envs: int = 1, max_episode_steps: int | None = None,
+                 **kwargs: Any) -> None:
         if isinstance(num_envs, bool) or not isinstance(num_envs, (int, np.integer)) \
                 or not 1 <= num_envs <= MAX_NUM_ENVS:
             raise ValueError(f"num_envs must be a whole number in [1, {MAX_NUM_ENVS}], "
                              f"not {num_envs!r}")
-        super().__init__([lambda: StealthEnv(**kwargs) for _ in range(int(num_envs))])
+        limit = max_episode_steps
+        if limit is not None and (isinstance(limit, bool) or not isinstance(limit, (int, np.integer))
+                                  or not (limit == -1 or limit >= 1)):
+            raise ValueError(f"max_episode_steps must be a whole number >= 1 (or -1 or None: "
+                             f"no limit), not {limit!r}")
+
+        def make() -> gymnasium.Env:
+            one = StealthEnv(**kwargs)
+            return one if limit is None or limit == -1 else \
+                gymnasium.wrappers.TimeLimit(one, int(limit))
+
+        super().__init__([make for _ in range(int(num_envs))])
 
     def action_masks(self) -> np.ndarray:
         return np.stack([env.unwrapped.action_masks() for env in self.envs])  # type: ignore[attr-defined]
 
 
+#: ``spec.max_episode_steps`` of the registered env: the default episode (60 s) in physics
+#: steps (1/20 s). An env step lasts at least one physics step, so the ``TimeLimit`` wrapper
+#: ``gymnasium.make`` adds never ends a default episode before the env's own clock does; a
+#: longer ``world.duration`` needs ``max_episode_steps=`` (or ``-1``: no wrapper) of its own.
+MAX_EPISODE_STEPS = 1200
+
 if ENV_ID not in gymnasium.registry:
     gymnasium.register(id=ENV_ID, entry_point="game.env:StealthEnv",
-                       vector_entry_point="game.env:StealthVectorEnv")
+                       vector_entry_point="game.env:StealthVectorEnv",
+                       max_episode_steps=MAX_EPISODE_STEPS)
 
-__all__ = ["ENV_ID", "GRID_ACTIONS", "GUARD_CHANNELS", "GUARD_FEATURES", "MOVE_FEATURES",
-           "OTHER_GUARD", "PARTITION_ACTIONS", "PLAYER_AS_SEEN", "PLAYER_CHANNELS",
-           "PLAYER_FEATURES", "PLAYER_GUARD", "REWARDS", "ExternalGuards", "ExternalPlayer",
-           "StealthEnv", "StealthParallelEnv", "StealthVectorEnv", "check_action", "parallel_env"]
+__all__ = ["ENV_ID", "GRID_ACTIONS", "GUARD_CHANNELS", "GUARD_FEATURES", "MAX_EPISODE_STEPS",
+           "MOVE_FEATURES", "OLD_PLAYER", "OTHER_GUARD", "PARTITION_ACTIONS", "PLAYER",
+           "PLAYER_AS_SEEN", "PLAYER_CHANNELS", "PLAYER_FEATURES", "PLAYER_GUARD", "REWARDS",
+           "OBSERVATIONS", "STATE_FEATURES", "STATE_GUARD", "AgentDict", "FlatObsWrapper",
+           "ImgObsWrapper", "ExternalGuards", "ExternalPlayer",
+           "StealthEnv", "StealthParallelEnv", "StealthVectorEnv", "agent_name", "check_action",
+           "env", "parallel_env", "raw_env"]

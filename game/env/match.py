@@ -286,12 +286,13 @@ class Match:
     def action_mask(self, node: int | None = None) -> np.ndarray:
         """Which actions move the agent on ``node`` (default: the player's); stay always can.
 
-        An action masked out is legal all the same (it stays): the mask only tells a
-        masking learner which actions are worth trying.
+        An ``int8`` array of 0 and 1, the dtype Gymnasium's ``Discrete.sample(mask=...)`` and
+        PettingZoo's API tests require. An action masked out is legal all the same (it
+        stays): the mask only tells a masking learner which actions are worth trying.
         """
         row = self.moves[self.world.player.node if node is None else node]
-        mask = row != row[0]
-        mask[0] = True
+        mask = (row != row[0]).view(np.int8)
+        mask[0] = 1
         return mask
 
     def guard_distance(self) -> float:

@@ -27,7 +27,7 @@ if TYPE_CHECKING:
 
 __all__ = ["GUARD_CHANNELS", "GUARD_FEATURES", "MOVE_FEATURES", "OBS_BOUND", "OTHER_GUARD",
            "Observer", "PLAYER_AS_SEEN", "PLAYER_CHANNELS", "PLAYER_FEATURES", "PLAYER_GUARD",
-           "active_guards"]
+           "STATE_FEATURES", "STATE_GUARD", "active_guards"]
 
 #: Every observation entry lies in [-OBS_BOUND, OBS_BOUND] (most in [-1, 1]).
 OBS_BOUND = 10.0
@@ -43,6 +43,12 @@ PLAYER_GUARD = ("known", "dx", "dy", "distance", "cos_heading", "sin_heading", "
 #: distance from its target to the nearest perceived guard ÷ (2 × view range), at most 1.
 MOVE_FEATURES = ("open", "safety")
 PLAYER_AS_SEEN = ("known", "dx", "dy")
+#: The global state (``parallel_env``'s ``state()``, for a centralised critic): the true
+#: positions of everyone, whatever anyone perceives; positions ÷ the level's width / height.
+STATE_FEATURES = ("time", "player_x", "player_y", "player_cos_heading", "player_sin_heading",
+                  "player_hp", "detected")
+#: The global state's slot per guard, in guard order.
+STATE_GUARD = ("active", "x", "y", "cos_heading", "sin_heading", "sees_player")
 
 
 def active_guards(view: WorldView) -> np.ndarray:
@@ -208,6 +214,22 @@ class Observer:
         d = (view.player_pos - pos) / self.diagonal
         vec += [1.0, d[0], d[1]] if team_sees else [0.0, 0.0, 0.0]
         return self._pack(win, vec)
+
+    def state(self, world: World, view: WorldView) -> np.ndarray:
+        """The global state: :data:`STATE_FEATURES`, then :data:`STATE_GUARD` per guard."""
+        pos, heading = view.player_pos, world.player.heading
+        vec = [min(1.0, view.t / self.duration), pos[0] / self.width, pos[1] / self.height,
+               math.cos(heading), math.sin(heading), world.hp / self.hp_max,
+               float(bool(view.seen_by))]
+        active = active_guards(view)
+        for j in range(self.n_guards):
+            g, h = view.guard_positions[j], float(view.guard_headings[j])
+            vec += [float(active[j]), g[0] / self.width, g[1] / self.height,
+                    math.cos(h), math.sin(h), float(j in view.seen_by)]
+        return np.clip(np.asarray(vec, dtype=np.float32), -OBS_BOUND, OBS_BOUND)
+
+    def state_size(self) -> int:
+        return len(STATE_FEATURES) + len(STATE_GUARD) * self.n_guards
 
     @staticmethod
     def _pack(win: np.ndarray, vec: list[float]) -> np.ndarray:
