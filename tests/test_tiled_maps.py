@@ -39,7 +39,7 @@ LOADS = {
     "arcade/test_objects.json": (20, 20, [
         "object 7 'crate1' (crate): unknown class 'crate', treated as decoration",
         "object 8 'coin1' (coin): unknown class 'coin', treated as decoration",
-        NO_GUARD, f"{EMPTY} (20x20 tiles)"]),
+        NO_GUARD]),  # its two tile objects of a tile with a collision polygon block
 }
 REFUSED = {
     "tiled_examples/hexagonal-mini.tmx": "map: orientation 'hexagonal' is not supported",
