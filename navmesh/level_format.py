@@ -116,6 +116,10 @@ class Level:
     patrols: tuple[tuple[Point, ...], ...] = ()
     """Each guard's patrol route (walkable points, in order; empty for a guard without one);
     empty when the level gives none at all."""
+    tiled: bool = False
+    """Whether the level was read from a Tiled map: guards a designer placed there start
+    where they stand in ``stealth sim`` unless ``world.spawns`` is set (JSON levels and
+    presets keep the configured rule)."""
 
     def __post_init__(self) -> None:
         occupancy = np.array(self.occupancy, dtype=bool)  # private copy, then frozen
@@ -175,7 +179,7 @@ class Level:
 
 def parse_level(
     data: Any, source: str = "<memory>", *, path: Path | None = None, digest: str | None = None,
-    require_guards: bool = True,
+    require_guards: bool = True, tiled: bool = False,
 ) -> Level:
     """Validate an in-memory level (the decoded JSON object) and build its :class:`Level`.
 
@@ -260,6 +264,7 @@ def parse_level(
         collectibles=collectibles,
         facing=facing,
         patrols=patrols,
+        tiled=tiled,
     )
 
 

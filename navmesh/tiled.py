@@ -114,7 +114,8 @@ def load_tiled(path: Path, source: str, digest: str | None = None,
         warnings.simplefilter("always", LevelWarning)
         data, origins = tiled_level_data(path, source, raw)
         try:
-            level = parse_level(data, source, path=path, digest=digest, require_guards=False)
+            level = parse_level(data, source, path=path, digest=digest, require_guards=False,
+                                tiled=True)
         except LevelError as exc:
             raise LevelError(source, _origin(exc.field, origins), exc.problem) from None
     for note in caught:

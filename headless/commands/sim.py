@@ -1,6 +1,9 @@
 """``stealth sim``: one trial, its metrics printed (SPEC §9), optionally its trace.
 
-The level and the config are loaded and checked once, here, and handed to the trial. With
+The level and the config are loaded and checked once, here, and handed to the trial. A Tiled
+map that places guards (objects of class ``guard``) runs with ``world.spawns = "level"`` unless
+``world.spawns`` is given: the designer put them there (its guards' ``facing`` and ``patrol``
+properties apply with it). With
 ``--set world.engine=batch`` the trial runs on the batch engine
 (``game.batch.run_trials([spec])[0]``, the same row), refused in one line when that engine
 does not cover it or a trace is asked for (it writes none).
@@ -24,7 +27,11 @@ from ..outputs.clobber import open_output, plugin_files
 from .failure import UsageError
 from .levels import emit_json
 
-__all__ = ["cmd_sim"]
+__all__ = ["SPAWNS_KEY", "cmd_sim"]
+
+SPAWNS_KEY = "world.spawns"
+"""A Tiled map that places guards starts them there in ``sim`` unless this key is set
+(``--set`` or ``--config``); JSON levels and presets keep the configured rule."""
 
 
 def _settings(items: Sequence[str], base: Mapping[str, Any] | None = None
@@ -47,6 +54,9 @@ def cmd_sim(args: argparse.Namespace) -> int:
     for plugin in args.stimulus:  # before the level: a plugin may declare its zone kinds
         load_stimulus(plugin)  # a bad plugin fails here with its one-line message
     level = load_level(args.level)  # a bad level fails here with its one-line message
+    overrides = _settings(args.set, read_config_file(args.config) if args.config else {})
+    if level.tiled and level.guards and SPAWNS_KEY not in dict(overrides):
+        overrides = ((SPAWNS_KEY, "level"), *overrides)  # in the key: replays start there too
     spec = TrialSpec(
         level=args.level,
         abstraction=args.abstraction,
@@ -54,7 +64,7 @@ def cmd_sim(args: argparse.Namespace) -> int:
         player=args.player,
         scenario=args.scenario,
         seed=args.seed,
-        overrides=_settings(args.set, read_config_file(args.config) if args.config else {}),
+        overrides=overrides,
         stimuli=tuple(args.stimulus),
     )
     config = Config.load(spec.settings)  # every key and value checked: one-line ConfigError
