@@ -241,3 +241,12 @@ def test_one_trial_on_each_map_through_the_python_api():
                          overrides=(("world.spawns", "level"), ("world.duration", 5)))
         row = run_trial(spec)
         assert np.isfinite(row["metrics"]["coverage"]) and row["metrics"]["coverage"] > 0, name
+
+
+def test_docs_list_the_wall_names_the_loader_reads():
+    from navmesh.tiled_classes import WALL_CLASSES, WALL_PROPERTIES
+
+    text = (ROOT / "docs" / "levels.md").read_text(encoding="utf-8")
+    classes = ", ".join(f"`{c}`" for c in WALL_CLASSES)
+    properties = ", ".join(f"`{p}`" for p in WALL_PROPERTIES)
+    assert f"is one of: {classes};" in text and f"named one of: {properties}," in text

@@ -32,6 +32,9 @@ LOADS = {
     "tiled_examples/sewers.tmx": (50, 50, [NO_GUARD, f"{EMPTY} (50x50 tiles)"]),
     "tiled_examples/perspective_walls.tmx": (32, 32, [
         NO_GUARD, "2 walkable cells in 2 pockets walled off from the rest"]),
+    "tiled_examples/sewer_automap/rule_001.tmx": (3, 7, [  # TMX 1.0: objects without id
+        "object 1 'StinkingAcid' (dmg): unknown class 'DMG', treated as decoration",
+        NO_GUARD, f"{EMPTY} (7x3 tiles)"]),
     "pytiled_parser/layer_tests/all_layer_types/map.json": (6, 8, [NO_GUARD, f"{EMPTY} (8x6 tiles)"]),
     "pytiled_parser/layer_tests/b64_zstd/map.tmx": (6, 8, [NO_GUARD, f"{EMPTY} (8x6 tiles)"]),
     "pytiled_parser/layer_tests/infinite_map/map.json": (7, 9, [NO_GUARD, f"{EMPTY} (infinite)"]),
