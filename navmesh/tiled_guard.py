@@ -32,13 +32,14 @@ import base64
 import binascii
 import math
 import os
+import xml.etree.ElementTree as etree
 from pathlib import Path
 from typing import Any, NoReturn
 
 from navmesh.errors import LevelError
 from navmesh.files import FileRefused, inflate_bounded, read_regular
 from navmesh.level_fields import MAX_CELLS, MAX_FILE_BYTES
-from navmesh.tiled_templates import Templates
+from navmesh.tiled_templates import MapTilesets, Templates
 
 __all__ = ["LAYER_TYPES", "MAX_CHUNK_CELLS", "MAX_COORDINATE", "MAX_NAMED_FILES", "MapFiles",
            "check_map_cells", "guard_map"]
@@ -104,12 +105,35 @@ def guard_map(doc: Any, folder: Path, source: str) -> MapFiles:
     the map's reader, which holds every file it named (its tilesets are read from it again).
     """
     files = MapFiles(source)
-    templates = Templates(files.read, source)
+    templates = Templates(files.read, source, _map_tilesets(doc, folder))
     if isinstance(doc, dict):
         _guard_json(doc, folder, files, templates)
     else:
         _guard_xml(doc, folder, files, templates)
     return files
+
+
+def _map_tilesets(doc: Any, folder: Path) -> MapTilesets:
+    """The map's external tilesets by file, for templates' tile objects; a tileset a template
+    names and the map lacks is added to the map's document (as Tiled adds it)."""
+    entries = (_list(doc.get("tilesets")) if isinstance(doc, dict)
+               else doc.findall("tileset"))
+    firstgids: dict[str, int] = {}
+    for entry in entries:
+        if not isinstance(entry, dict) and isinstance(doc, dict):
+            continue
+        named, first = entry.get("source"), _number(entry.get("firstgid", 1))
+        if isinstance(named, str) and named and first is not None and math.isfinite(first):
+            firstgids.setdefault(os.path.normpath(folder / named), int(first))
+
+    def add(first: int, path: str) -> None:
+        relative = os.path.relpath(path, folder)
+        if isinstance(doc, dict):
+            doc.setdefault("tilesets", []).append({"firstgid": first, "source": relative})
+        else:
+            etree.SubElement(doc, "tileset", firstgid=str(first), source=relative)
+
+    return MapTilesets(firstgids, add)
 
 
 class ObjectIds:

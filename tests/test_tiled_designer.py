@@ -250,3 +250,27 @@ def test_docs_list_the_wall_names_the_loader_reads():
     classes = ", ".join(f"`{c}`" for c in WALL_CLASSES)
     properties = ", ".join(f"`{p}`" for p in WALL_PROPERTIES)
     assert f"is one of: {classes};" in text and f"named one of: {properties}," in text
+
+
+def test_a_template_tile_object_counts_its_gid_in_the_template_s_tileset(tmp_path):
+    """A template's gid is numbered in the template's own tileset (Sticker Knight's hero.tx
+    names ``../objs.tsx`` at firstgid 1): it is moved to where that tileset sits in the map,
+    and a tileset the map lacks is added, as Tiled does."""
+    for name in ("props.tsj", "dungeon.tsx"):
+        (tmp_path / name).write_text((HERE / name).read_text())
+    (tmp_path / "t").mkdir()
+    (tmp_path / "t" / "crate_guard.tj").write_text(json.dumps({
+        "type": "template", "tileset": {"firstgid": 11, "source": "../props.tsj"},
+        "object": {"gid": 14, "width": 32, "height": 32, "name": "", "rotation": 0,
+                   "visible": True}}))
+    (tmp_path / "t" / "dungeon_guard.tx").write_text(
+        '<?xml version="1.0"?><template><tileset firstgid="1" source="../dungeon.tsx"/>'
+        '<object gid="3" width="32" height="32"/></template>')
+    doc = json.loads((HERE / "by_collides.tmj").read_text())
+    doc["layers"][1]["objects"] = [
+        {"id": 20, "template": "t/crate_guard.tj", "x": 224, "y": 224},
+        {"id": 21, "template": "t/dungeon_guard.tx", "x": 160, "y": 128}]
+    (tmp_path / "m.tmj").write_text(json.dumps(doc))
+    level = load_level(tmp_path / "m.tmj")
+    assert level.guards == ((7.5, 6.5), (5.5, 3.5))
+    assert _cells(level) == BY_COLLIDES  # the added tileset changes no tile of the map
