@@ -368,7 +368,7 @@ def _collect(
         if isinstance(layer, tl.LayerGroup):
             _collect(layer.layers or [], f"{name}/", lx, ly, found, src)
         elif isinstance(layer, tl.TileLayer):
-            is_walls = WALLS.name in (layer.name.strip().lower(), _class_of(layer))
+            is_walls = bool(set(WALL_CLASSES) & {layer.name.strip().lower(), _class_of(layer)})
             cols, rows, gids = _nonzero_tiles(layer, name, src, required=is_walls)
             if is_walls:
                 found.walls.append((name, cols, rows, lx, ly))
@@ -450,7 +450,9 @@ def _collision_shape(obj: to.TiledObject, where: str, src: str) -> Polygon | Non
         return None
     described = f"{where} collision object {obj.id}"
     geometry = _object_geometry(obj, 0.0, 0.0, described, src, want_area=True)
-    return geometry if geometry.is_valid else geometry.buffer(0)
+    if not geometry.is_valid:
+        _fail(src, described, "collision shape is not a simple polygon (its sides cross)")
+    return geometry
 
 
 def _describe_object(obj: to.TiledObject, layer: str, cls: str) -> str:

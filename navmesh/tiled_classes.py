@@ -85,9 +85,10 @@ BUILT_IN = (WALLS, GUARD, DECOY, COLLECTIBLE, PLAYER, OBSTACLE, OUTLINE, EXIT)
 
 WALL_CLASSES = (WALLS.name, "wall", "solid", "collision", "collisions", "collider",
                 "colliders", "blocked", OBSTACLE.name, "obstacles")
-"""Classes (and object layer names) Tiled users mark walls with (:mod:`navmesh.tiled_tiles`):
-a tileset tile of one of these classes is a wall tile; an object of one of them (or without
-a class in an object layer named or of one of them) is a blocked area."""
+"""Classes (and layer names) Tiled users mark walls with (:mod:`navmesh.tiled_tiles`): a
+tileset tile of one of these classes is a wall tile; a tile layer named or of one of them is
+a walls layer (every non-zero tile blocked); an object of one of them (or without a class in
+an object layer named or of one of them) is a blocked area."""
 
 WALL_PROPERTIES = ("collides", "collide", "collision", "collidable", "solid", "blocked",
                    "blocks", "wall", "obstacle")

@@ -274,3 +274,45 @@ def test_a_template_tile_object_counts_its_gid_in_the_template_s_tileset(tmp_pat
     level = load_level(tmp_path / "m.tmj")
     assert level.guards == ((7.5, 6.5), (5.5, 3.5))
     assert _cells(level) == BY_COLLIDES  # the added tileset changes no tile of the map
+
+
+def test_layers_and_objects_named_for_collision_block(tmp_path):
+    """A tile layer named ``Collision`` blocks every tile on it (any tile); a shape without a
+    class in an object layer named ``Collisions`` and an object of class ``solid`` block
+    their area; a point there blocks nothing."""
+    (tmp_path / "props.tsj").write_text((HERE / "props.tsj").read_text())
+    doc = json.loads((HERE / "by_collides.tmj").read_text())
+    guard = doc["layers"][1]["objects"][0]
+    guard["properties"] = [p for p in guard["properties"] if p["name"] != "patrol"]
+    floor = [0] * 80
+    floor[1 * 10 + 1] = 1  # the floor tile: no wall anywhere else
+    doc["layers"].append({"id": 5, "name": "Collision", "type": "tilelayer", "width": 10,
+                          "height": 8, "opacity": 1, "visible": True, "x": 0, "y": 0,
+                          "data": floor})
+    shape = {"height": 32, "width": 32, "name": "", "rotation": 0, "visible": True}
+    doc["layers"].append({"id": 6, "name": "Collisions", "type": "objectgroup",
+                          "draworder": "topdown", "opacity": 1, "visible": True, "x": 0,
+                          "y": 0, "objects": [
+                              {**shape, "id": 30, "x": 256, "y": 32},
+                              {**shape, "id": 31, "x": 100, "y": 100, "point": True,
+                               "width": 0, "height": 0}]})
+    doc["layers"][1]["objects"].append({**shape, "id": 32, "x": 128, "y": 192,
+                                        "type": "Solid"})
+    (tmp_path / "m.tmj").write_text(json.dumps(doc))
+    level = load_level(tmp_path / "m.tmj")
+    blocked = {(1, 1), (1, 8), (6, 4)}
+    for r, row in enumerate(BY_COLLIDES):
+        for c, ch in enumerate(row):
+            assert level.occupancy[r, c] == (ch == "." and (r, c) not in blocked), (r, c)
+
+
+def test_a_collision_shape_whose_sides_cross_is_one_line(tmp_path):
+    doc = json.loads((HERE / "props.tsj").read_text())
+    doc["tiles"][0]["objectgroup"] = {"type": "objectgroup", "objects": [
+        {"id": 7, "x": 0, "y": 0, "polygon": [{"x": 0, "y": 0}, {"x": 32, "y": 32},
+                                              {"x": 32, "y": 0}, {"x": 0, "y": 32}]}]}
+    (tmp_path / "props.tsj").write_text(json.dumps(doc))
+    (tmp_path / "m.tmj").write_text((HERE / "by_collides.tmj").read_text())
+    with pytest.raises(LevelError, match=r"m.tmj: tileset 'props' tile 1 collision object 7: "
+                                         r"collision shape is not a simple polygon"):
+        load_level(tmp_path / "m.tmj")
