@@ -316,3 +316,11 @@ def test_a_collision_shape_whose_sides_cross_is_one_line(tmp_path):
     with pytest.raises(LevelError, match=r"m.tmj: tileset 'props' tile 1 collision object 7: "
                                          r"collision shape is not a simple polygon"):
         load_level(tmp_path / "m.tmj")
+
+
+def test_a_zone_kind_named_like_a_wall_class_is_refused():
+    from navmesh.level import register_zone_kind
+
+    with pytest.raises(ValueError, match="zone kind 'Solid': a Tiled map could not tell it "
+                                         "from the class 'solid'"):
+        register_zone_kind("Solid")

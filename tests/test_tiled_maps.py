@@ -212,3 +212,40 @@ def test_a_broken_copy_of_a_published_map_is_a_one_line_error(tmp_path, name):
                 load_level(path)
             except LevelError as error:
                 assert "\n" not in str(error)
+
+
+def _collision_conventions(path: Path) -> list[str]:
+    """What in a map marks walls the ways Tiled users do (issue 41): layers named or of a
+    wall class, tiles of such a class, with a collides-style property, or collision shapes."""
+    from pytiled_parser import layer as tl
+
+    from navmesh.tiled_classes import WALL_CLASSES, WALL_PROPERTIES
+    from navmesh.tiled_read import read_map
+
+    tmap = read_map(path, path.read_bytes(), str(path))
+    found = []
+
+    def walk(layers):
+        for layer in layers:
+            if {layer.name.strip().lower(), (layer.class_ or "").lower()} & set(WALL_CLASSES):
+                found.append(f"layer {layer.name}")
+            if isinstance(layer, tl.LayerGroup):
+                walk(layer.layers or [])
+    walk(tmap.layers)
+    for tileset in tmap.tilesets.values():
+        for tile in (tileset.tiles or {}).values():
+            if (tile.class_ or "").lower() in WALL_CLASSES or tile.objects is not None or any(
+                    str(k).lower() in WALL_PROPERTIES for k in (tile.properties or {})):
+                found.append(f"tileset {tileset.name} tile {tile.id}")
+    return found
+
+
+@pytest.mark.parametrize("name", sorted(LOADS))
+def test_no_published_map_with_a_collision_convention_is_an_empty_box(name):
+    conventions = _collision_conventions(HELD / name)
+    empty = any(EMPTY in part for part in LOADS[name][2])
+    assert empty == (not conventions), conventions
+    if conventions:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            assert not load_level(HELD / name).occupancy.all()
