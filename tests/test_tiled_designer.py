@@ -20,6 +20,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from ai.baselines import ScriptedGuards
 from game.config import Config
 from game.trial import TrialSpec, make_world, run_trial
 from headless.cli import main
@@ -167,6 +168,7 @@ def test_an_fsm_guard_walks_its_patrol_route_in_order():
     world = make_world(spec, Config.load(spec.settings), level=level)
     route = [world.graph.node_at(*p) for p in level.patrols[0]]
     ai = world.guard_ai
+    assert isinstance(ai, ScriptedGuards)
     targets: list[int] = []
     while not world.done and len(targets) < 7:
         world.step()
