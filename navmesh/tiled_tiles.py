@@ -48,8 +48,8 @@ from navmesh.errors import LevelError
 from navmesh.tiled_classes import WALL_CLASSES, WALL_PROPERTIES
 from navmesh.tiled_format import is_tiled_xml
 
-__all__ = ["FLIP_MASK", "FULL_COVER", "MAX_TILESET_SHAPES", "MAX_TILE_SHAPES", "WALL_CLASSES",
-           "WALL_PROPERTIES", "TileRules", "TileWall", "read_tilesets"]
+__all__ = ["FLIP_MASK", "FULL_COVER", "MAX_SHAPE_POINTS", "MAX_TILESET_SHAPES", "MAX_TILE_ENTRIES",
+           "MAX_TILE_SHAPES", "TileRules", "TileWall", "read_tilesets"]
 
 
 FULL_COVER = 0.99
@@ -63,6 +63,11 @@ MAX_TILESET_SHAPES = 50_000
 
 MAX_SHAPE_POINTS = 10_000
 """Polygon corners one tile's collision shapes may hold together."""
+
+MAX_TILE_ENTRIES = 100_000
+"""Tiles described one by one (a class, properties, shapes, an image) in all of a map's
+tilesets: a 64 MiB tileset of a million bare entries would otherwise cost seconds and a
+gigabyte to parse, for nothing a level reads."""
 
 FLIP_MASK = 0x0FFFFFFF
 """A gid without Tiled's flip and rotation flags (its top four bits)."""
@@ -242,6 +247,13 @@ class _Budget:
     def __init__(self, source: str) -> None:
         self.source = source
         self.total = 0
+        self.tiles = 0
+
+    def count_tiles(self, tiles: int, where: str) -> None:
+        self.tiles += tiles
+        if self.tiles > MAX_TILE_ENTRIES:
+            _fail(self.source, where, f"more than {MAX_TILE_ENTRIES} tiles described in the "
+                                      "map's tilesets")
 
     def charge(self, shapes: int, points: int, where: str) -> None:
         if shapes > MAX_TILE_SHAPES:
@@ -257,6 +269,13 @@ class _Budget:
 
 
 def _decode(raw: bytes, path: Path, source: str, where: str) -> Any:
+    # counted on the bytes before they are parsed (a 64 MiB tileset of bare tiles takes a
+    # gigabyte as a tree): an upper bound of the tiles (and, in JSON, objects) it describes
+    entries = (sum(raw.count(b"<tile" + end) for end in (b" ", b">", b"/", b"\n", b"\t"))
+               if is_tiled_xml(raw) else raw.count(b'"id"'))
+    if entries > MAX_TILE_ENTRIES + MAX_TILESET_SHAPES:
+        _fail(source, where, f"more than {MAX_TILE_ENTRIES} tiles described in the map's "
+                             "tilesets")
     try:
         if is_tiled_xml(raw):
             root = etree.fromstring(raw)
@@ -277,6 +296,7 @@ def _xml_copy(tileset: Any, budget: _Budget, where: str) -> Any:
     """A ``<tileset>`` holding what a level reads, with the defaults older Tiled left out."""
     a = tileset.attrib
     tiles = tileset.findall("tile")
+    budget.count_tiles(len(tiles), where)
     copy = etree.Element("tileset", {
         "name": a.get("name", ""), "tilewidth": a.get("tilewidth", "0"),
         "tileheight": a.get("tileheight", "0"), "tilecount": a.get("tilecount", str(len(tiles))),
@@ -323,6 +343,7 @@ def _json_copy(tileset: dict[str, Any], budget: _Budget, where: str) -> dict[str
             tile.setdefault("properties", props)
         tiles = list(by_id.values())
     kept_tiles = []
+    budget.count_tiles(len(tiles) if isinstance(tiles, list) else 0, where)
     for tile in tiles if isinstance(tiles, list) else []:
         if not isinstance(tile, dict):
             continue

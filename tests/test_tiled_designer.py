@@ -326,3 +326,19 @@ def test_a_zone_kind_named_like_a_wall_class_is_refused():
     with pytest.raises(ValueError, match="zone kind 'Solid': a Tiled map could not tell it "
                                          "from the class 'solid'"):
         register_zone_kind("Solid")
+
+
+def test_a_tileset_describing_too_many_tiles_is_one_line_before_it_is_parsed(tmp_path):
+    from navmesh.tiled_tiles import MAX_TILE_ENTRIES
+
+    count = MAX_TILE_ENTRIES + 1
+    (tmp_path / "dungeon.tsx").write_text(
+        '<?xml version="1.0"?><tileset name="d" tilewidth="32" tileheight="32" '
+        f'tilecount="{count}" columns="1">'
+        + "".join(f'<tile id="{i}" type="x"/>' for i in range(count)) + "</tileset>")
+    (tmp_path / "m.tmx").write_text((HERE / "by_class.tmx").read_text())
+    start = time.monotonic()
+    with pytest.raises(LevelError, match=r"tilesets\[0\] 'dungeon.tsx': more than 100000 tiles "
+                                         r"described in the map's tilesets"):
+        load_level(tmp_path / "m.tmx")
+    assert time.monotonic() - start < 5
