@@ -37,6 +37,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Callable, NoReturn, cast
 
+import numpy as np
 import shapely
 from pytiled_parser import Tileset
 from pytiled_parser import tiled_object as to
@@ -98,20 +99,18 @@ class TileWall:
         w, h = self.width, self.height
         if self.full:
             return [box(x0, y0, x0 + w * sx, y0 + h * sy)]
-        out = []
-        for shape in self.shapes:
-            def move(xy: Any, flips: int = gid) -> Any:
-                x, y = xy[:, 0].copy(), xy[:, 1].copy()
-                if flips & _D:
-                    x, y = y * (w / h), x * (h / w)
-                if flips & _H:
-                    x = w - x
-                if flips & _V:
-                    y = h - y
-                xy[:, 0], xy[:, 1] = x0 + x * sx, y0 + y * sy
-                return xy
-            out.append(shapely.transform(shape, move))
-        return out
+
+        def move(xy: Any) -> Any:
+            x, y = xy[:, 0].copy(), xy[:, 1].copy()
+            if gid & _D:  # within the tile's footprint (a non-square tile keeps its size)
+                x, y = y * (w / h), x * (h / w)
+            if gid & _H:
+                x = w - x
+            if gid & _V:
+                y = h - y
+            return np.column_stack([x0 + x * sx, y0 + y * sy])
+
+        return [shapely.transform(shape, move) for shape in self.shapes]
 
 
 class TileRules:

@@ -342,3 +342,19 @@ def test_a_tileset_describing_too_many_tiles_is_one_line_before_it_is_parsed(tmp
                                          r"described in the map's tilesets"):
         load_level(tmp_path / "m.tmx")
     assert time.monotonic() - start < 5
+
+
+def test_flipped_wall_tiles_flip_their_collision_shapes():
+    from shapely.geometry import box
+
+    from navmesh.tiled_tiles import TileWall
+
+    low = TileWall(32.0, 32.0, (box(0, 0, 32, 12),))  # the top 12 pixels
+    side = TileWall(32.0, 32.0, (box(0, 0, 8, 32),))  # the left 8 pixels
+    H, V, D = 0x80000000, 0x40000000, 0x20000000
+    assert low.placed(3, 64, 0)[0].bounds == (64, 0, 96, 12)
+    assert low.placed(3 | V, 64, 0)[0].bounds == (64, 20, 96, 32)
+    assert low.placed(3 | D, 64, 0)[0].bounds == (64, 0, 76, 32)
+    assert side.placed(3 | H, 0, 0)[0].bounds == (24, 0, 32, 32)
+    assert side.placed(3, 10, 20, 2.0, 0.5)[0].bounds == (10, 20, 26, 36)
+    assert TileWall(32.0, 32.0, ()).placed(3 | H, 0, 0)[0].bounds == (0, 0, 32, 32)
