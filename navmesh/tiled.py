@@ -184,6 +184,7 @@ def tiled_level_data(path: Path, source: str, raw: bytes | None = None
         data[OUTLINE.field] = _ring(world(outline))
         origins[OUTLINE.field] = where
         obstacles = [*obstacle_objects, *_wall_rectangles(found, outline, tile)]
+        obstacles += [("map", piece) for piece in _walled_off(outline, obstacles, tile, source)]
         data[OBSTACLE.field] = [_ring(world(geometry)) for _, geometry in obstacles]
         origins.update((f"{OBSTACLE.field}[{i}]", where) for i, (where, _) in enumerate(obstacles))
         if not obstacles:
@@ -652,6 +653,27 @@ def _block_pockets(blocked: np.ndarray, src: str) -> None:
     _warn(src, "map", f"{int(pockets.sum())} walkable cells in {count - 1} pockets walled off "
                       f"from the rest (the first at row {row}, col {col}) are treated as blocked")
     blocked[pockets] = True
+
+
+def _walled_off(outline: Polygon, obstacles: list[tuple[str, Any]], tile: float, src: str
+                ) -> list[Polygon]:
+    """Walkable pieces cut off from the largest by the obstacles, which become blocked too,
+    with one warning, as a grid level's pockets are: a designer's closed room or wall
+    interior is unreachable anyway, and a level must be one piece."""
+    if not obstacles:
+        return []
+    walkable = outline.difference(shapely.union_all([g for _, g in obstacles]))
+    pieces = sorted(shapely.get_parts(walkable), key=lambda p: p.area, reverse=True)
+    pieces = [p for p in pieces if isinstance(p, Polygon) and p.area > 0]
+    if len(pieces) <= 1:
+        return []
+    cut = pieces[1:]
+    area = sum(p.area for p in cut) / tile**2
+    x, y = cut[0].representative_point().coords[0]
+    _warn(src, "map", f"{len(cut)} walkable pieces ({area:.3g} tiles in all) walled off from "
+                      f"the rest (the first around tile ({x / tile:.3g}, {y / tile:.3g})) are "
+                      "treated as blocked")
+    return [Polygon(p.exterior) for p in cut]
 
 
 def _wall_rectangles(

@@ -358,3 +358,23 @@ def test_flipped_wall_tiles_flip_their_collision_shapes():
     assert side.placed(3 | H, 0, 0)[0].bounds == (24, 0, 32, 32)
     assert side.placed(3, 10, 20, 2.0, 0.5)[0].bounds == (10, 20, 26, 36)
     assert TileWall(32.0, 32.0, ()).placed(3 | H, 0, 0)[0].bounds == (0, 0, 32, 32)
+
+
+def test_a_room_closed_by_wall_objects_is_blocked_with_a_warning(tmp_path):
+    """Solid objects off the tile grid closing a room: the room is unreachable, so it is
+    blocked with one warning, as a grid level's pockets are, instead of refusing the map
+    ("walkable area is in 2 disconnected pieces")."""
+    ring = [(2.25, 3.25, 3.5, 0.25), (2.25, 6.5, 3.5, 0.25),  # x, y, width, height in tiles
+            (2.25, 3.25, 0.25, 3.5), (5.5, 3.25, 0.25, 3.5)]
+    walls = "".join(f'<object type="solid" x="{x * 32}" y="{y * 32}" width="{w * 32}" '
+                    f'height="{h * 32}"/>' for x, y, w, h in ring)
+    text = (HERE / "by_shapes.tmx").read_text().replace(" </objectgroup>\n</map>",
+                                                        walls + "</objectgroup></map>")
+    (tmp_path / "m.tmx").write_text(text)
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        level = load_level(tmp_path / "m.tmx")
+    notes = [str(w.message) for w in caught if issubclass(w.category, LevelWarning)]
+    assert len(notes) == 1 and "1 walkable pieces (9 tiles in all) walled off" in notes[0], notes
+    assert not level.contains(4.0, 5.0) and not level.occupancy[4:6, 3:5].any()
+    assert level.occupancy[1, 1:9].all()
