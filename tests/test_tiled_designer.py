@@ -378,3 +378,17 @@ def test_a_room_closed_by_wall_objects_is_blocked_with_a_warning(tmp_path):
     assert len(notes) == 1 and "1 walkable pieces (9 tiles in all) walled off" in notes[0], notes
     assert not level.contains(4.0, 5.0) and not level.occupancy[4:6, 3:5].any()
     assert level.occupancy[1, 1:9].all()
+
+
+def test_the_python_api_starts_placed_guards_as_sim_does():
+    from headless.api import build_world, run_one, trial_spec
+
+    path = str(HERE / "by_class.tmx")
+    assert dict(trial_spec(path).overrides)["world.spawns"] == "level"
+    assert dict(trial_spec(path, overrides={"world.spawns": "random"}).overrides) == {
+        "world.spawns": "random"}
+    assert trial_spec("maze").overrides == ()
+    world = build_world(path, guards="fsm")
+    assert [g.heading for g in world.guards] == pytest.approx([math.pi / 2, math.pi])
+    assert run_one(path, guards="fsm", overrides={"world.duration": 2})["config"][
+        "world.spawns"] == "level"

@@ -19,7 +19,7 @@ from typing import Any
 from ai.stimuli import load_stimulus
 from game.config import ENGINE_KEY, Config, parse_overrides
 from game.config_file import read_config_file
-from game.trial import TrialSpec, make_world, run_trial, sim_document
+from game.trial import TrialSpec, make_world, placed_spawns, run_trial, sim_document
 from navmesh.level import load_level, resolve_level_path
 
 from ..engines import BATCH, check_covered, refusal
@@ -27,11 +27,7 @@ from ..outputs.clobber import open_output, plugin_files
 from .failure import UsageError
 from .levels import emit_json
 
-__all__ = ["SPAWNS_KEY", "cmd_sim"]
-
-SPAWNS_KEY = "world.spawns"
-"""A Tiled map that places guards starts them there in ``sim`` unless this key is set
-(``--set`` or ``--config``); JSON levels and presets keep the configured rule."""
+__all__ = ["cmd_sim"]
 
 
 def _settings(items: Sequence[str], base: Mapping[str, Any] | None = None
@@ -54,9 +50,8 @@ def cmd_sim(args: argparse.Namespace) -> int:
     for plugin in args.stimulus:  # before the level: a plugin may declare its zone kinds
         load_stimulus(plugin)  # a bad plugin fails here with its one-line message
     level = load_level(args.level)  # a bad level fails here with its one-line message
-    overrides = _settings(args.set, read_config_file(args.config) if args.config else {})
-    if level.tiled and level.guards and SPAWNS_KEY not in dict(overrides):
-        overrides = ((SPAWNS_KEY, "level"), *overrides)  # in the key: replays start there too
+    overrides = placed_spawns(level, _settings(
+        args.set, read_config_file(args.config) if args.config else {}))
     spec = TrialSpec(
         level=args.level,
         abstraction=args.abstraction,
