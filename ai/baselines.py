@@ -8,7 +8,7 @@ the shortest path by :func:`~ai.view.move_horizon` (one cell on the grid).
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any, ClassVar
 
@@ -112,6 +112,25 @@ class ScriptedGuards(GuardAI):
         self.guards = [GuardState() for _ in range(n_guards)]
         self.last_known: int | None = None
         self._extra = np.zeros(graph.n)
+        self._routes: dict[int, list[int]] = {}
+        self._route_at: dict[int, int] = {}
+
+    def set_patrol_routes(self, routes: Sequence[Sequence[int]]) -> None:
+        """A guard with a route patrols it in order, round and round (from its first point),
+        instead of choosing its patrol targets; chase, investigate and return are unchanged,
+        and Patrol resumes the route where it left it."""
+        self._routes = {i: [int(v) for v in route] for i, route in enumerate(routes)
+                        if len(route) and i < self.n_guards}
+        self._route_at = {i: -1 for i in self._routes}
+
+    def _route_target(self, i: int, node: int) -> int:
+        """The next node of guard ``i``'s route that is not ``node``."""
+        route = self._routes[i]
+        for _ in range(len(route)):
+            self._route_at[i] = (self._route_at[i] + 1) % len(route)
+            if route[self._route_at[i]] != node:
+                break
+        return route[self._route_at[i]]
 
     # ------------------------------------------------------------------ stimuli hook
     @property
@@ -231,7 +250,8 @@ class ScriptedGuards(GuardAI):
             goal = gs.route_node
         else:
             if gs.target is None or node == gs.target:
-                gs.target = self._patrol_target(i, node)
+                gs.target = (self._route_target(i, node) if i in self._routes
+                             else self._patrol_target(i, node))
             goal = gs.target
         return self.graph.step_towards(node, goal, self.horizon)
 

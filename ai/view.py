@@ -177,6 +177,12 @@ class GuardAI(ABC):
         fields = self.fields()
         return tuple(id(a) for a in fields.values()), lambda: fields
 
+    def set_patrol_routes(self, routes: Sequence[Sequence[int]]) -> None:
+        """Receive each guard's patrol route as nodes, in order (an empty route: none), from
+        a level that gives routes (a Tiled guard's ``patrol`` property) and places the
+        guards (``world.spawns = "level"``); called after :meth:`reset`. Default: ignored
+        (modes that choose where to patrol from their fields keep doing so)."""
+
     def wants_guard_sight(self) -> bool:
         """Whether the mode reads :attr:`WorldView.guard_sight` at its AI ticks (default: no,
         so the world does not compute it)."""

@@ -78,6 +78,22 @@ def _identity(settings: tuple[tuple[str, Any], ...]) -> tuple[tuple[str, Any], .
     return tuple((k, v) for k, v in settings if k not in IDENTITY_NEUTRAL)
 
 
+SPAWNS_KEY = "world.spawns"
+"""The config key of where guards start (``random`` or ``level``)."""
+
+
+def placed_spawns(level: Level, overrides: tuple[tuple[str, Any], ...]
+                  ) -> tuple[tuple[str, Any], ...]:
+    """A single trial's overrides (``stealth sim``, :func:`headless.api.run_one`) with
+    ``world.spawns = "level"`` first when the level is a Tiled map that places guards and
+    the overrides do not set the key: a designer who drew guards means them to start there
+    (with their ``facing`` and ``patrol``). JSON levels and designs (presets) keep the
+    configured rule. The setting is part of the trial's key, so a replay starts alike."""
+    if level.tiled and level.guards and SPAWNS_KEY not in dict(overrides):
+        return ((SPAWNS_KEY, "level"), *overrides)
+    return overrides
+
+
 def trial_rngs(spec: TrialSpec, level_name: str) -> Generators:
     """Generators for spawns, guards and player, derived from the trial's identity.
 
@@ -219,5 +235,6 @@ def sim_document(row: Mapping[str, Any]) -> dict[str, Any]:
     }
 
 
-__all__: Sequence[str] = ["TrialSpec", "identity_row", "run_trial", "make_world", "trial_rngs",
+__all__: Sequence[str] = ["SPAWNS_KEY", "TrialSpec", "identity_row", "placed_spawns",
+                          "run_trial", "make_world", "trial_rngs",
                           "trial_row", "sim_document"]

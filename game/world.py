@@ -117,12 +117,20 @@ class World(PlayerActions):
         self.guards = [self.locomotion.make_agent(node, guard_speed) for node in spawn_nodes]
         for guard in self.guards:
             guard.heading = float(spawn_rng.uniform(-math.pi, math.pi))
+        placed = str(w["spawns"]) == "level" and bool(level.guards)
+        if placed:  # a Tiled guard's facing (the draw above is kept: the same stream)
+            for guard, facing in zip(self.guards, level.facing):
+                if facing is not None:
+                    guard.heading = facing
         first = level_start_node(self.graph, level, str(w["spawns"]))
         self.player = self.locomotion.make_agent(
             self.start_node() if first is None else first, player_speed)
         self.player_speed = player_speed
 
         self.guard_ai.reset(self.graph, guard_rng, len(self.guards))
+        if placed and level.patrols:
+            self.guard_ai.set_patrol_routes(
+                [[self.graph.node_at(x, y) for x, y in route] for route in level.patrols])
         if self.player_policy is not None:
             self.player_policy.reset(self.graph, player_rng)
         for i, guard in enumerate(self.guards):

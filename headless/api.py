@@ -19,8 +19,10 @@ from pathlib import Path
 from typing import Any
 
 from ai import DEFAULT_GUARD_MODE, DEFAULT_PLAYER_POLICY
-from game.trial import TrialSpec, make_world, run_trial
+from ai.stimuli import load_stimulus
+from game.trial import TrialSpec, make_world, placed_spawns, run_trial
 from game.world import World
+from navmesh.level import cached_level
 
 from .errors import UserError
 from .presets import Preset, load_preset
@@ -34,9 +36,15 @@ def trial_spec(level: str, *, abstraction: str = "grid",
                scenario: str = "capture", seed: int = 0,
                overrides: Mapping[str, Any] | None = None,
                stimuli: Sequence[str] = ()) -> TrialSpec:
-    """The :class:`~game.trial.TrialSpec` of these settings (``overrides``: config keys)."""
+    """The :class:`~game.trial.TrialSpec` of these settings (``overrides``: config keys);
+    a Tiled map that places guards starts them there unless ``world.spawns`` is given, as in
+    ``stealth sim`` (:func:`game.trial.placed_spawns`)."""
+    for plugin in stimuli:  # before the level: a plugin may declare its zone kinds
+        load_stimulus(plugin)
     return TrialSpec(level, abstraction, guards, player, scenario, seed,
-                     overrides=tuple(sorted((overrides or {}).items())), stimuli=tuple(stimuli))
+                     overrides=placed_spawns(cached_level(level),
+                                             tuple(sorted((overrides or {}).items()))),
+                     stimuli=tuple(stimuli))
 
 
 def run_one(level: str, **settings: Any) -> dict[str, Any]:

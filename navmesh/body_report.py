@@ -81,7 +81,7 @@ def local_parts(walkable: Polygon, r: float) -> Parts:
     with_shell = labels[:n] == labels[n]
     narrow, pieces = exact_parts(Polygon(walkable.exterior.coords,
                                          [walkable.interiors[i].coords
-                                          for i in np.flatnonzero(with_shell)]), r)
+                                          for i in np.flatnonzero(with_shell).tolist()]), r)
     group_of = labels[:n]
     checked = ~with_shell & ((sizes[group_of] > 1) | concave)
     members_of: dict[int, list[int]] = {}

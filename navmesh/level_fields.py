@@ -17,7 +17,7 @@ from shapely.geometry.polygon import orient
 
 from navmesh.errors import LevelError
 from navmesh.names import name_problem
-from navmesh.tiled_classes import BUILT_IN
+from navmesh.tiled_classes import BUILT_IN, WALL_CLASSES
 
 __all__ = ["MAX_CELLS", "MAX_LEVEL_VERTICES", "MAX_POLYGON_VERTICES", "MAX_SPOTS", "ZONE_KINDS", "register_zone_kind", "zone_kinds"]
 
@@ -60,13 +60,15 @@ def register_zone_kind(kind: str) -> None:
     a key of ``Level.zones``; levels parsed before keep the kinds they were parsed with.
     A kind is a word (:func:`navmesh.names.name_problem`), because it is a Tiled class and
     a key of ``zones``; a Tiled map matches classes case-insensitively, so a kind named like
-    a built-in Tiled class (``guard``, ``walls``, ...) or like another kind in another case
-    is refused (``ValueError``): a map's guard spawns would silently become zones.
+    a built-in Tiled class (``guard``, ``walls``, ...), a wall class (``solid``, ...) or
+    like another kind in another case is refused (``ValueError``): a map's guard spawns or
+    walls would silently become zones.
     """
     problem = name_problem(kind)
     if problem is not None:
         raise ValueError(f"a zone kind {problem}")
-    taken = [c.name for c in BUILT_IN] + [k for k in _zone_kinds if k != kind]
+    taken = ([c.name for c in BUILT_IN] + list(WALL_CLASSES)
+             + [k for k in _zone_kinds if k != kind])
     clash = next((name for name in taken if name.lower() == kind.lower()), None)
     if clash is not None:
         raise ValueError(f"zone kind {kind!r}: a Tiled map could not tell it from the class "

@@ -76,7 +76,7 @@ FORMAT = "stealth-level/1"
 _REQUIRED_KEYS = ("format", "name", "guards")
 _OPTIONAL_KEYS = (
     "cell_size", "outline", "obstacles", "grid", "zones", "decoys",
-    "player", "exits", "collectibles",
+    "player", "exits", "collectibles", "facing", "patrols",
 )
 _ALLOWED_KEYS = _REQUIRED_KEYS + _OPTIONAL_KEYS
 @dataclass(frozen=True, eq=False)
@@ -109,6 +109,17 @@ class Level:
     """Areas the player leaves the level through (objectives, issue 16)."""
     collectibles: tuple[Point, ...] = ()
     """Items the player can pick up (objectives, issue 16)."""
+    facing: tuple[float | None, ...] = ()
+    """Each guard's heading at its spawn point, in radians (0 = +x, π/2 = +y, down on the
+    screen), ``None`` where the level gives none; empty when it gives none at all. Used with
+    ``world.spawns = "level"``."""
+    patrols: tuple[tuple[Point, ...], ...] = ()
+    """Each guard's patrol route (walkable points, in order; empty for a guard without one);
+    empty when the level gives none at all."""
+    tiled: bool = False
+    """Whether the level was read from a Tiled map: guards a designer placed there start
+    where they stand in ``stealth sim`` unless ``world.spawns`` is set (JSON levels and
+    presets keep the configured rule)."""
 
     def __post_init__(self) -> None:
         occupancy = np.array(self.occupancy, dtype=bool)  # private copy, then frozen
@@ -168,7 +179,7 @@ class Level:
 
 def parse_level(
     data: Any, source: str = "<memory>", *, path: Path | None = None, digest: str | None = None,
-    require_guards: bool = True,
+    require_guards: bool = True, tiled: bool = False,
 ) -> Level:
     """Validate an in-memory level (the decoded JSON object) and build its :class:`Level`.
 
@@ -236,6 +247,8 @@ def parse_level(
     exit_areas = tuple(_polygons_overlapping(
         exits, walkable, src, "exits", "exit does not overlap the walkable area"
     ))
+    facing = _parse_facing(data.get("facing"), len(guards), src)
+    patrols = _parse_patrols(data.get("patrols"), len(guards), src, level_spots)
     return Level(
         name=name,
         path=path,
@@ -249,4 +262,31 @@ def parse_level(
         player=player,
         exits=exit_areas,
         collectibles=collectibles,
+        facing=facing,
+        patrols=patrols,
+        tiled=tiled,
     )
+
+
+def _parse_facing(value: Any, guards: int, src: str) -> tuple[float | None, ...]:
+    """``facing``: one entry per guard, degrees clockwise on the screen from +x (0 = east,
+    90 = south) or null; kept in radians."""
+    if value is None:
+        return ()
+    if not isinstance(value, _ARRAY_TYPES) or len(value) != guards:
+        _fail(src, "facing", f"expected an array of {guards} numbers or nulls (one per guard), "
+                             f"got {_describe(value)}")
+    return tuple(None if v is None else math.radians(_number(v, src, f"facing[{i}]"))
+                 for i, v in enumerate(value))
+
+
+def _parse_patrols(value: Any, guards: int, src: str, level_spots: dict[str, Any]
+                   ) -> tuple[tuple[Point, ...], ...]:
+    """``patrols``: one route per guard, each an array of walkable points (may be empty)."""
+    if value is None:
+        return ()
+    if not isinstance(value, _ARRAY_TYPES) or len(value) != guards:
+        _fail(src, "patrols", f"expected an array of {guards} routes (one per guard), got "
+                              f"{_describe(value)}")
+    return tuple(_parse_spots(route, src, f"patrols[{i}]", required=False, **level_spots)
+                 for i, route in enumerate(value))

@@ -12,9 +12,18 @@ Conventions (documented for level designers in ``docs/levels.md``):
 * the classes of layers and objects, and what each becomes, are those of
   :mod:`navmesh.tiled_classes` (points: a point object, or the centre of any other shape;
   areas: rectangle, polygon, ellipse as a 32-gon, rotation honoured);
-* blocked: the non-zero tiles of the walls layers and the obstacle objects; the outline is
-  the map's bounds unless an outline object is given (an infinite map is cut to the bounds
-  of its walls and obstacles, shifted by whole tiles so that they start at the origin).
+* blocked: the non-zero tiles of the walls layers, the tiles of any layer that the tileset
+  marks as walls (:mod:`navmesh.tiled_tiles`: a tile class, a ``collides``-style property,
+  collision shapes), the obstacle objects, objects of a wall class (``wall``, ``solid``,
+  ``collision``, ...), shapes without a class in an object layer named or of such a class,
+  and tile objects of wall tiles; the outline is the map's bounds unless an outline object
+  is given (an infinite map is cut to the bounds of its walls and obstacles, shifted by
+  whole tiles so that they start at the origin);
+* a tile object is its rectangle, whose origin is its bottom-left corner (Tiled's rule for
+  tile objects), and takes its tile's class when it has none of its own;
+* a guard object's properties ``facing`` (degrees clockwise from +x, or a compass word) and
+  ``patrol`` (a reference to a polyline, polygon or point object, or "x,y x,y ..." in tiles)
+  become the level's ``facing`` and ``patrols``.
 
 Object classes are matched on the object's ``class`` (Tiled >= 1.9) or legacy ``type``,
 case-insensitively; objects without a class are decoration and ignored, and so is an
@@ -41,14 +50,18 @@ import shapely
 from scipy import ndimage
 from pytiled_parser import layer as tl
 from pytiled_parser import tiled_object as to
+from pytiled_parser.common_types import Size
+from shapely import affinity
 from shapely.geometry import Polygon, box
 
 from navmesh.errors import LevelError, LevelWarning
-from navmesh.level_fields import zone_kinds
+from navmesh.level_fields import MAX_LEVEL_VERTICES, zone_kinds
 from navmesh.level_format import Level, parse_level
-from navmesh.tiled_classes import OBSTACLE, OUTLINE, WALLS, TiledClass, object_classes
+from navmesh.tiled_classes import (GUARD, OBSTACLE, OUTLINE, WALL_CLASSES, WALLS, TiledClass,
+                                   object_classes)
 from navmesh.tiled_guard import MapFiles, check_map_cells
 from navmesh.tiled_read import read_map
+from navmesh.tiled_tiles import TileRules, TileWall
 
 __all__ = ["ELLIPSE_SIDES", "MAX_TILE_PIXELS", "load_tiled", "tiled_level_data"]
 
@@ -67,6 +80,10 @@ class _Collected:
 
     classes: dict[str, TiledClass]
     """The object classes known when the map is read, by name (zone kinds included)."""
+    rules: TileRules
+    """What each tile of the map's tilesets is (its class; whether it is a wall)."""
+    tile: float
+    """The map's tile size in pixels."""
     walls: list[tuple[str, np.ndarray, np.ndarray, float, float]] = field(default_factory=list)
     """(layer, tile columns, tile rows, offset x px, offset y px) of each walls layer."""
     shapes: dict[str, list[tuple[str, Any]]] = field(default_factory=dict)
@@ -76,6 +93,12 @@ class _Collected:
     tile_boxes: list[tuple[float, float, float, float]] = field(default_factory=list)
     """Tile bounds (x0, y0, x1, y1 in columns and rows) of the non-zero tiles of each tile
     layer: an infinite map's extent when it has no walls, obstacles or outline."""
+    guards: list[tuple[to.TiledObject, float, float, str]] = field(default_factory=list)
+    """Each guard object with its layer's offset and its description, in the guards' order."""
+    by_id: dict[int, tuple[to.TiledObject, float, float]] = field(default_factory=dict)
+    """Every object by id, with its layer's offset (what a ``patrol`` property refers to)."""
+    corners: int = 0
+    """Corners of the obstacles made from collision shapes so far (bounded)."""
 
 
 def load_tiled(path: Path, source: str, digest: str | None = None,
@@ -91,7 +114,8 @@ def load_tiled(path: Path, source: str, digest: str | None = None,
         warnings.simplefilter("always", LevelWarning)
         data, origins = tiled_level_data(path, source, raw)
         try:
-            level = parse_level(data, source, path=path, digest=digest, require_guards=False)
+            level = parse_level(data, source, path=path, digest=digest, require_guards=False,
+                                tiled=True)
         except LevelError as exc:
             raise LevelError(source, _origin(exc.field, origins), exc.problem) from None
     for note in caught:
@@ -120,9 +144,10 @@ def tiled_level_data(path: Path, source: str, raw: bytes | None = None
         _fail(source, "map", f"tiles {tile_w} pixels wide are not supported; tiles are at "
                              f"most {MAX_TILE_PIXELS} pixels wide")
     cell_size = _cell_size(tmap, source)
-    found = _Collected({c.name: c for c in object_classes(zone_kinds())})
-    _collect(tmap.layers, "", 0.0, 0.0, found, source)
     tile = float(tile_w)
+    rules = TileRules(tmap.tilesets or {}, lambda obj, where: _collision_shape(obj, where, source))
+    found = _Collected({c.name: c for c in object_classes(zone_kinds())}, rules, tile)
+    _collect(tmap.layers, "", 0.0, 0.0, found, source)
     for cls in found.classes.values():
         objects = found.shapes.get(cls.name, [])
         if cls.single and len(objects) > 1:
@@ -159,6 +184,7 @@ def tiled_level_data(path: Path, source: str, raw: bytes | None = None
         data[OUTLINE.field] = _ring(world(outline))
         origins[OUTLINE.field] = where
         obstacles = [*obstacle_objects, *_wall_rectangles(found, outline, tile)]
+        obstacles += [("map", piece) for piece in _walled_off(outline, obstacles, tile, source)]
         data[OBSTACLE.field] = [_ring(world(geometry)) for _, geometry in obstacles]
         origins.update((f"{OBSTACLE.field}[{i}]", where) for i, (where, _) in enumerate(obstacles))
         if not obstacles:
@@ -178,7 +204,104 @@ def tiled_level_data(path: Path, source: str, raw: bytes | None = None
         _put(data, cls.field, values)
         origins[cls.field] = f"objects of class {cls.name!r}"
         origins.update((f"{cls.field}[{i}]", where) for i, (where, _) in enumerate(objects))
+    _guard_properties(found, data, origins, world, tile, source)
     return data, origins
+
+
+def _guard_properties(found: _Collected, data: dict[str, Any], origins: dict[str, str],
+                      world: Any, tile: float, src: str) -> None:
+    """``facing`` and ``patrols`` from the guard objects' properties (only when one has them)."""
+    facing = [_facing(obj, where, src) for obj, _, _, where in found.guards]
+    routes = [_patrol(obj, where, found, tile, src) for obj, _, _, where in found.guards]
+    if any(f is not None for f in facing):
+        data["facing"] = facing
+        origins.update((f"facing[{i}]", g[3]) for i, g in enumerate(found.guards))
+    if any(routes):
+        data["patrols"] = [[_xy(world(shapely.Point(p))) for p in route] for route in routes]
+        origins.update((f"patrols[{i}]", g[3]) for i, g in enumerate(found.guards))
+
+
+_COMPASS = {"east": 0.0, "e": 0.0, "right": 0.0, "south": 90.0, "s": 90.0, "down": 90.0,
+            "west": 180.0, "w": 180.0, "left": 180.0, "north": 270.0, "n": 270.0, "up": 270.0}
+
+
+def _property(obj: to.TiledObject, name: str) -> Any:
+    """The object's custom property ``name`` (any case), or None."""
+    for key, value in (obj.properties or {}).items():
+        if str(key).strip().lower() == name:
+            return value
+    return None
+
+
+def _facing(obj: to.TiledObject, where: str, src: str) -> float | None:
+    """A guard's ``facing`` property in degrees clockwise on the screen from +x, or None."""
+    value = _property(obj, "facing")
+    if value is None or value == "":
+        return None
+    if isinstance(value, str):
+        word = value.strip().lower()
+        if word in _COMPASS:
+            return _COMPASS[word]
+        try:
+            value = float(word)
+        except ValueError:
+            _fail(src, where, f"property facing: expected degrees or one of "
+                              f"{', '.join(sorted(set(_COMPASS)))}, got {value!r}")
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        _fail(src, where, f"property facing: expected a number of degrees, got {value!r}")
+    _finite(src, where, "property facing", _float(value))
+    return float(value)
+
+
+def _patrol(obj: to.TiledObject, where: str, found: _Collected, tile: float, src: str
+            ) -> list[tuple[float, float]]:
+    """A guard's ``patrol`` route in map pixels: the points of the object it refers to (an
+    object property, or an id), or a string of "x,y" pairs in tiles; [] for none."""
+    value = _property(obj, "patrol")
+    if value is None or value == "" or value == 0:
+        return []
+    if isinstance(value, int) and not isinstance(value, bool) or (
+            isinstance(value, str) and value.strip().isdigit()):
+        ref = int(value)
+        if ref == 0:
+            return []
+        if ref not in found.by_id:
+            _fail(src, where, f"property patrol: no object with id {ref}")
+        target, ox, oy = found.by_id[ref]
+        return _route_points(target, ox, oy, f"object {ref}", src)
+    if isinstance(value, str):
+        pairs = value.replace(";", " ").split()
+        try:
+            points = [tuple(float(v) * tile for v in pair.split(",")) for pair in pairs]
+        except ValueError:
+            points = []
+        if not points or any(len(p) != 2 for p in points):
+            _fail(src, where, f"property patrol: expected an object or \"x,y x,y ...\" in "
+                              f"tiles, got {value!r}")
+        _finite(src, where, "property patrol", *(v for p in points for v in p))
+        return [(p[0], p[1]) for p in points]
+    _fail(src, where, f"property patrol: expected an object or \"x,y x,y ...\" in tiles, "
+                      f"got {value!r}")
+
+
+def _route_points(obj: to.TiledObject, ox: float, oy: float, where: str, src: str
+                  ) -> list[tuple[float, float]]:
+    """The points of a route object in map pixels: a polyline's or polygon's corners in
+    order (rotation honoured), a point, or the centre of any other shape."""
+    x, y = _float(obj.coordinates.x) + ox, _float(obj.coordinates.y) + oy
+    _finite(src, where, "position", x, y)
+    if isinstance(obj, (to.Polyline, to.Polygon)):
+        local = np.array([(_float(p.x), _float(p.y)) for p in obj.points]).reshape(-1, 2)
+        _finite(src, where, "points", *local.ravel())
+        theta = math.radians(_float(obj.rotation))
+        if theta:
+            cos, sin = math.cos(theta), math.sin(theta)
+            local = local @ np.array([[cos, sin], [-sin, cos]])
+        return [(float(px + x), float(py + y)) for px, py in local]
+    if isinstance(obj, to.Point):
+        return [(x, y)]
+    centre = _object_geometry(obj, ox, oy, where, src, want_area=False)
+    return [(float(centre.x), float(centre.y))]
 
 
 def _put(data: dict[str, Any], field_name: str, value: Any) -> None:
@@ -246,38 +369,91 @@ def _collect(
         if isinstance(layer, tl.LayerGroup):
             _collect(layer.layers or [], f"{name}/", lx, ly, found, src)
         elif isinstance(layer, tl.TileLayer):
-            is_walls = WALLS.name in (layer.name.strip().lower(), _class_of(layer))
-            cols, rows = _nonzero_tiles(layer, name, src, required=is_walls)
+            is_walls = bool(set(WALL_CLASSES) & {layer.name.strip().lower(), _class_of(layer)})
+            cols, rows, gids = _nonzero_tiles(layer, name, src, required=is_walls)
             if is_walls:
                 found.walls.append((name, cols, rows, lx, ly))
+            elif cols.size:
+                _collect_wall_tiles(name, cols, rows, gids, lx, ly, found, src)
             if cols.size:
                 found.tile_boxes.append((float(cols.min()), float(rows.min()),
                                          float(cols.max() + 1), float(rows.max() + 1)))
                 found.tile_offsets.append((lx, ly))
         elif isinstance(layer, tl.ObjectLayer):
+            walls = set(WALL_CLASSES) & {layer.name.strip().lower(), _class_of(layer)}
             for obj in layer.tiled_objects:
-                _collect_object(obj, name, lx, ly, found, src)
+                _collect_object(obj, name, lx, ly, found, src, collision_layer=bool(walls))
         # image layers are pictures only
 
 
 def _nonzero_tiles(layer: tl.TileLayer, name: str, src: str, *, required: bool
-                   ) -> tuple[np.ndarray, np.ndarray]:
-    """Tile columns and rows (layer coordinates) of the layer's non-zero gids; a layer
-    without tile data is an error if ``required`` (a walls layer), else has none."""
+                   ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Tile columns, rows (layer coordinates) and gids (flip flags kept) of the layer's
+    non-zero tiles; a layer without tile data is an error if ``required`` (a walls layer),
+    else has none."""
     blocks: list[tuple[float, float, list[list[int]]]] = (
         [(0, 0, layer.data)] if layer.data is not None else [])
     blocks += [(c.coordinates.x, c.coordinates.y, c.data) for c in layer.chunks or []]
-    cols, rows = [], []
+    cols, rows, gids = [], [], []
     for x0, y0, data in blocks:
         for r, row in enumerate(data):
-            c = np.flatnonzero(np.asarray(row, dtype=np.int64))
+            values = np.asarray(row, dtype=np.int64)
+            c = np.flatnonzero(values)
             cols.append(c + int(x0))
             rows.append(np.full(c.size, r + int(y0)))
+            gids.append(values[c])
     if not cols:
         if required:
             _fail(src, f"layer {name!r}", "walls layer has no tile data")
-        return np.zeros(0, np.int64), np.zeros(0, np.int64)
-    return np.concatenate(cols), np.concatenate(rows)
+        return np.zeros(0, np.int64), np.zeros(0, np.int64), np.zeros(0, np.int64)
+    return np.concatenate(cols), np.concatenate(rows), np.concatenate(gids)
+
+
+def _collect_wall_tiles(name: str, cols: np.ndarray, rows: np.ndarray, gids: np.ndarray,
+                        ox: float, oy: float, found: _Collected, src: str) -> None:
+    """The layer's tiles that its tileset marks as walls: whole cells when the tile is
+    blocked whole and one cell in size, else obstacles (its collision shapes, or its
+    rectangle when it is larger than a cell), drawn as Tiled draws tiles: bottom-left on
+    the cell."""
+    unique, inverse = np.unique(gids, return_inverse=True)
+    walls: list[TileWall | None] = [found.rules.wall(int(g)) for g in unique]
+    tile = found.tile
+    cell = np.array([w is not None and w.full and (w.width, w.height) == (tile, tile)
+                     for w in walls], dtype=bool)[inverse]
+    other = np.array([w is not None for w in walls], dtype=bool)[inverse] & ~cell
+    if cell.any():
+        found.walls.append((name, cols[cell], rows[cell], ox, oy))
+    for i in np.flatnonzero(other):
+        wall = walls[int(inverse[i])]
+        assert wall is not None
+        c, r, gid = int(cols[i]), int(rows[i]), int(gids[i])
+        where = f"layer {name!r} tile at row {r}, column {c}"
+        for polygon in wall.placed(gid, c * tile + ox, (r + 1) * tile + oy - wall.height):
+            _add_obstacle(found, where, polygon, src)
+
+
+def _add_obstacle(found: _Collected, where: str, polygon: Polygon, src: str) -> None:
+    """An obstacle made from a tile's collision shape, bounded in corners before the level's
+    own checks (a large map of small shapes must not build without end)."""
+    found.corners += len(polygon.exterior.coords) - 1
+    if found.corners > MAX_LEVEL_VERTICES:
+        _fail(src, where, f"the wall tiles' collision shapes have more than "
+                          f"{MAX_LEVEL_VERTICES} corners in all")
+    found.shapes.setdefault(OBSTACLE.name, []).append((where, polygon))
+
+
+def _collision_shape(obj: to.TiledObject, where: str, src: str) -> Polygon | None:
+    """A tile's collision object as a polygon in tile pixels; None for one without area."""
+    if not isinstance(obj, (to.Rectangle, to.Ellipse, to.Polygon)):
+        return None
+    if not isinstance(obj, to.Polygon) and (_float(obj.size.width) <= 0
+                                            or _float(obj.size.height) <= 0):
+        return None
+    described = f"{where} collision object {obj.id}"
+    geometry = _object_geometry(obj, 0.0, 0.0, described, src, want_area=True)
+    if not geometry.is_valid:
+        _fail(src, described, "collision shape is not a simple polygon (its sides cross)")
+    return geometry
 
 
 def _describe_object(obj: to.TiledObject, layer: str, cls: str) -> str:
@@ -286,9 +462,22 @@ def _describe_object(obj: to.TiledObject, layer: str, cls: str) -> str:
 
 
 def _collect_object(
-    obj: to.TiledObject, layer: str, ox: float, oy: float, found: _Collected, src: str
+    obj: to.TiledObject, layer: str, ox: float, oy: float, found: _Collected, src: str, *,
+    collision_layer: bool = False
 ) -> None:
+    found.by_id.setdefault(int(obj.id), (obj, ox, oy))
     cls = _class_of(obj)
+    wall: TileWall | None = None
+    gid = 0
+    if isinstance(obj, to.Tile):
+        gid = obj.gid
+        _tile_object_size(obj, found)
+        cls = cls or found.rules.class_of(obj.gid)  # Tiled: an object takes its tile's class
+        wall = found.rules.wall(obj.gid)
+    if (cls in WALL_CLASSES and cls != OBSTACLE.name) or (
+            not cls and (wall is not None or collision_layer)):
+        _collect_wall_object(obj, layer, ox, oy, found, src, wall, gid)
+        return
     if not cls:
         return  # decoration
     where = _describe_object(obj, layer, cls)
@@ -299,15 +488,45 @@ def _collect_object(
         return
     geometry = _object_geometry(obj, ox, oy, where, src, want_area=found.classes[cls].is_area)
     found.shapes.setdefault(cls, []).append((where, geometry))
+    if cls == GUARD.name:
+        found.guards.append((obj, ox, oy, where))
+
+
+def _tile_object_size(obj: to.Tile, found: _Collected) -> None:
+    """A tile object written without a size (older Tiled) has its tile's."""
+    if _float(obj.size.width) <= 0 or _float(obj.size.height) <= 0:
+        size = found.rules.size_of(obj.gid)
+        if size is not None:
+            obj.size = Size(*size)
+
+
+def _collect_wall_object(obj: to.TiledObject, layer: str, ox: float, oy: float,
+                         found: _Collected, src: str, wall: TileWall | None, gid: int
+                         ) -> None:
+    """An object that blocks: of a wall class, in a collision layer, or a wall tile placed
+    as a tile object (its collision shapes scaled to the object, or its rectangle)."""
+    if isinstance(obj, (to.Point, to.Polyline, to.Text)):
+        return  # no area: nothing to block
+    where = _describe_object(obj, layer, OBSTACLE.name)
+    if wall is None or wall.full:
+        _add_obstacle(found, where, _object_geometry(obj, ox, oy, where, src, want_area=True),
+                      src)
+        return
+    w, h = _float(obj.size.width), _float(obj.size.height)
+    x, y = _float(obj.coordinates.x) + ox, _float(obj.coordinates.y) + oy
+    _finite(src, where, "position and size", x, y, w, h, _float(obj.rotation))
+    if w <= 0 or h <= 0:
+        _fail(src, where, f"shape of {w:g}x{h:g} pixels has no area")
+    for polygon in wall.placed(gid, x, y - h, w / wall.width, h / wall.height):
+        if obj.rotation:
+            polygon = affinity.rotate(polygon, _float(obj.rotation), origin=(x, y))
+        _add_obstacle(found, where, polygon, src)
 
 
 def _object_geometry(
     obj: to.TiledObject, ox: float, oy: float, where: str, src: str, *, want_area: bool
 ) -> Any:
     """The object's shape in map pixels: a polygon, or a point for a point object."""
-    if isinstance(obj, to.Tile):
-        _fail(src, where, "tile objects have no shape; use a point, rectangle, polygon or "
-                          "ellipse object")
     if isinstance(obj, to.Text):
         _fail(src, where, "text objects have no shape; use a point, rectangle, polygon or "
                           "ellipse object")
@@ -329,6 +548,8 @@ def _object_geometry(
         local = np.column_stack([w / 2 * (1 + np.cos(angles)), h / 2 * (1 + np.sin(angles))])
     elif isinstance(obj, to.Rectangle):
         local = np.array([(0.0, 0.0), (w, 0.0), (w, h), (0.0, h)])
+    elif isinstance(obj, to.Tile):  # drawn upwards from its origin, the bottom-left corner
+        local = np.array([(0.0, -h), (w, -h), (w, 0.0), (0.0, 0.0)])
     else:  # pragma: no cover - pytiled-parser has no other object kinds
         _fail(src, where, f"unsupported object kind {type(obj).__name__}")
     if not isinstance(obj, to.Polygon) and (w <= 0 or h <= 0):
@@ -366,8 +587,10 @@ def _warn_of_missing_parts(found: _Collected, tmap: pytiled_parser.TiledMap, src
                 else f"{int(tmap.map_size.width)}x{int(tmap.map_size.height)} tiles")
         _warn(src, "map", f"no walls, obstacles or outline: the level is an empty box "
                           f"({size}); blocked cells are the tiles of a tile layer named or of "
-                          f"class {WALLS.name!r} and objects of class {OBSTACLE.name!r}, an "
-                          f"object of class {OUTLINE.name!r} is the boundary")
+                          f"class {WALLS.name!r}, tiles the tileset marks as walls (a class "
+                          f"such as 'wall', a 'collides' property, collision shapes) and "
+                          f"objects of class {OBSTACLE.name!r}, an object of class "
+                          f"{OUTLINE.name!r} is the boundary")
 
 
 def _wall_tiles(found: _Collected, tile: float) -> tuple[np.ndarray, np.ndarray]:
@@ -430,6 +653,27 @@ def _block_pockets(blocked: np.ndarray, src: str) -> None:
     _warn(src, "map", f"{int(pockets.sum())} walkable cells in {count - 1} pockets walled off "
                       f"from the rest (the first at row {row}, col {col}) are treated as blocked")
     blocked[pockets] = True
+
+
+def _walled_off(outline: Polygon, obstacles: list[tuple[str, Any]], tile: float, src: str
+                ) -> list[Polygon]:
+    """Walkable pieces cut off from the largest by the obstacles, which become blocked too,
+    with one warning, as a grid level's pockets are: a designer's closed room or wall
+    interior is unreachable anyway, and a level must be one piece."""
+    if not obstacles:
+        return []
+    walkable = outline.difference(shapely.union_all([g for _, g in obstacles]))
+    pieces = sorted(shapely.get_parts(walkable), key=lambda p: p.area, reverse=True)
+    pieces = [p for p in pieces if isinstance(p, Polygon) and p.area > 0]
+    if len(pieces) <= 1:
+        return []
+    cut = pieces[1:]
+    area = sum(p.area for p in cut) / tile**2
+    x, y = cut[0].representative_point().coords[0]
+    _warn(src, "map", f"{len(cut)} walkable pieces ({area:.3g} tiles in all) walled off from "
+                      f"the rest (the first around tile ({x / tile:.3g}, {y / tile:.3g})) are "
+                      "treated as blocked")
+    return [Polygon(p.exterior) for p in cut]
 
 
 def _wall_rectangles(

@@ -19,7 +19,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Iterable
 
-__all__ = ["AREA", "AREAS", "BUILT_IN", "COLLECTIBLE", "DECOY", "EXIT", "GUARD", "OBSTACLE",
+__all__ = ["AREA", "AREAS", "BUILT_IN", "WALL_CLASSES", "WALL_PROPERTIES", "COLLECTIBLE", "DECOY", "EXIT", "GUARD", "OBSTACLE",
            "OUTLINE", "PLAYER", "POINT", "POINTS", "TILES", "WALLS", "TiledClass",
            "markdown_table", "object_classes", "tiled_classes", "zone_class"]
 
@@ -82,6 +82,17 @@ EXIT = TiledClass("exit", AREAS, "exits", "an exit area")
 
 BUILT_IN = (WALLS, GUARD, DECOY, COLLECTIBLE, PLAYER, OBSTACLE, OUTLINE, EXIT)
 """The classes that are not zone kinds, in the order messages and docs list them."""
+
+WALL_CLASSES = (WALLS.name, "wall", "solid", "collision", "collisions", "collider",
+                "colliders", "blocked", OBSTACLE.name, "obstacles")
+"""Classes (and layer names) Tiled users mark walls with (:mod:`navmesh.tiled_tiles`): a
+tileset tile of one of these classes is a wall tile; a tile layer named or of one of them is
+a walls layer (every non-zero tile blocked); an object of one of them (or without a class in
+an object layer named or of one of them) is a blocked area."""
+
+WALL_PROPERTIES = ("collides", "collide", "collision", "collidable", "solid", "blocked",
+                   "blocks", "wall", "obstacle")
+"""Boolean tile properties (any case) that make a tile a wall when true and none when false."""
 
 
 def zone_class(kind: str) -> TiledClass:

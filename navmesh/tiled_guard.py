@@ -17,7 +17,11 @@ rules as every other input:
   TMX's old ``<tile gid="…"/>`` form is rewritten as the CSV it means;
 * sizes meet the cell limit and chunk coordinates and layer offsets lie within ±2^31; a
   layer or chunk of no tiles is dropped (pytiled-parser would divide by its zero width), and
-  a JSON object gets the keys every Tiled writes (``name``, ``visible``, ...) if it lacks them.
+  a JSON object gets the keys every Tiled writes (``name``, ``visible``, ...) if it lacks them;
+* an object without an ``id`` (TMX 1.0 and JSON maps of Tiled < 1.0 wrote none) gets the next
+  free one, in document order, as Tiled itself does when it opens such a map;
+* a JSON layer of a type Tiled does not write is one line naming the layer and the types
+  there are (pytiled-parser raised a ``RuntimeError``).
 
 A map that passes is one pytiled-parser reads in bounded time and memory.
 """
@@ -28,16 +32,21 @@ import base64
 import binascii
 import math
 import os
+import xml.etree.ElementTree as etree
 from pathlib import Path
 from typing import Any, NoReturn
 
 from navmesh.errors import LevelError
 from navmesh.files import FileRefused, inflate_bounded, read_regular
 from navmesh.level_fields import MAX_CELLS, MAX_FILE_BYTES
-from navmesh.tiled_templates import Templates
+from navmesh.tiled_templates import MapTilesets, Templates
 
-__all__ = ["MAX_CHUNK_CELLS", "MAX_COORDINATE", "MAX_NAMED_FILES", "MapFiles",
+__all__ = ["LAYER_TYPES", "MAX_CHUNK_CELLS", "MAX_COORDINATE", "MAX_NAMED_FILES", "MapFiles",
            "check_map_cells", "guard_map"]
+
+LAYER_TYPES = ("tilelayer", "objectgroup", "imagelayer", "group")
+"""The layer types of a JSON map (TMX's elements of the same meaning: ``layer``,
+``objectgroup``, ``imagelayer``, ``group``; other TMX elements are not layers)."""
 
 MAX_CHUNK_CELLS = 4 * MAX_CELLS
 """Tiles an infinite map's chunks may hold together (its content must still fit in
@@ -88,18 +97,58 @@ class MapFiles:
         return raw
 
 
-def guard_map(doc: Any, folder: Path, source: str) -> None:
+def guard_map(doc: Any, folder: Path, source: str) -> MapFiles:
     """Check (and normalise in place) a decoded map: a JSON ``dict`` or a TMX root element.
 
     Raises one :class:`LevelError` for a named file that is not a bounded regular file, a
-    layer whose data is not width × height valid gids, or a size beyond the limits.
+    layer whose data is not width × height valid gids, or a size beyond the limits. Returns
+    the map's reader, which holds every file it named (its tilesets are read from it again).
     """
     files = MapFiles(source)
-    templates = Templates(files.read, source)
+    templates = Templates(files.read, source, _map_tilesets(doc, folder))
     if isinstance(doc, dict):
         _guard_json(doc, folder, files, templates)
     else:
         _guard_xml(doc, folder, files, templates)
+    return files
+
+
+def _map_tilesets(doc: Any, folder: Path) -> MapTilesets:
+    """The map's external tilesets by file, for templates' tile objects; a tileset a template
+    names and the map lacks is added to the map's document (as Tiled adds it)."""
+    entries = (_list(doc.get("tilesets")) if isinstance(doc, dict)
+               else doc.findall("tileset"))
+    firstgids: dict[str, int] = {}
+    for entry in entries:
+        if not isinstance(entry, dict) and isinstance(doc, dict):
+            continue
+        named, first = entry.get("source"), _number(entry.get("firstgid", 1))
+        if isinstance(named, str) and named and first is not None and math.isfinite(first):
+            firstgids.setdefault(os.path.normpath(folder / named), int(first))
+
+    def add(first: int, path: str) -> None:
+        relative = os.path.relpath(path, folder)
+        if isinstance(doc, dict):
+            doc.setdefault("tilesets", []).append({"firstgid": first, "source": relative})
+        else:
+            etree.SubElement(doc, "tileset", firstgid=str(first), source=relative)
+
+    return MapTilesets(firstgids, add)
+
+
+class ObjectIds:
+    """Ids for objects written without one, as Tiled gives them when it opens such a map:
+    the map's ``nextobjectid`` onwards, never one an object of the map already has."""
+
+    def __init__(self, next_id: Any, taken: list[Any]) -> None:
+        given = _number(next_id)
+        used = [n for n in map(_number, taken) if n is not None and math.isfinite(n)]
+        self.next = max(int(given) if given is not None and math.isfinite(given) else 1,
+                        int(max(used, default=0)) + 1, 1)
+
+    def take(self) -> int:
+        value, self.next = self.next, self.next + 1
+        return value
 
 
 def check_map_cells(width: int, height: int, source: str, what: str = "map") -> None:
@@ -181,14 +230,23 @@ def _guard_json(doc: dict[str, Any], folder: Path, files: MapFiles, templates: T
         if isinstance(tileset, dict) and isinstance(tileset.get("source"), str):
             files.read(folder / tileset["source"], f"tilesets[{i}].source")
     chunks = _ChunkTally()
-    for name, layer in _json_layers(_list(doc.get("layers")), ""):
+    layers = list(_json_layers(_list(doc.get("layers")), ""))
+    ids = ObjectIds(doc.get("nextobjectid"),
+                    [o.get("id") for _, layer in layers for o in _list(layer.get("objects"))
+                     if isinstance(o, dict) and o.get("id") is not None])
+    for name, layer in layers:
         where = f"layer {name!r}"
+        if layer.get("type") not in LAYER_TYPES:
+            _fail(source, where, f"unknown layer type {layer.get('type')!r} (Tiled's layer "
+                                 f"types are {', '.join(LAYER_TYPES)})")
         _check_coordinates(source, where, "offset", layer.get("offsetx", 0),
                           layer.get("offsety", 0))
         if layer.get("type") == "tilelayer":
             _guard_json_tiles(layer, where, source, chunks)
         objects = _list(layer.get("objects"))
         for i, obj in enumerate(objects):
+            if isinstance(obj, dict) and obj.get("id") is None:
+                obj["id"] = ids.take()
             if isinstance(obj, dict) and "template" in obj:
                 objects[i] = obj = templates.inline_json(obj, folder,
                                                          f"{where} object {obj.get('id')}")
@@ -276,13 +334,19 @@ def _guard_xml(root: Any, folder: Path, files: MapFiles, templates: Templates) -
         if tileset.get("source"):
             files.read(folder / tileset.get("source"), f"tilesets[{i}].source")
     chunks = _ChunkTally()
-    for name, layer in _xml_layers(root, ""):
+    layers = list(_xml_layers(root, ""))
+    ids = ObjectIds(root.get("nextobjectid"),
+                    [o.get("id") for _, layer in layers for o in layer
+                     if o.tag == "object" and o.get("id") is not None])
+    for name, layer in layers:
         where = f"layer {name!r}"
         _check_coordinates(source, where, "offset", layer.get("offsetx", 0),
                           layer.get("offsety", 0))
         if layer.tag == "layer":
             _guard_xml_tiles(layer, where, source, chunks)
         for i, obj in enumerate(list(layer)):
+            if obj.tag == "object" and obj.get("id") is None:
+                obj.set("id", str(ids.take()))
             if obj.tag == "object" and obj.get("template") is not None:
                 layer[i] = templates.inline_xml(obj, folder, f"{where} object {obj.get('id')}")
 

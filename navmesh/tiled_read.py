@@ -1,9 +1,10 @@
-"""Read a Tiled map's header, layers and properties — TMX (XML) or JSON — without its tilesets.
+"""Read a Tiled map's header, layers, properties and tilesets — TMX (XML) or JSON.
 
-A level needs only which gids are non-zero, so tilesets (embedded, ``.tsx``, ``.tsj``) are
-never parsed and their images never opened: an external tileset is only checked to be a
-bounded regular file (:mod:`navmesh.tiled_guard`), and a map written by an older Tiled
-without ``tilecount`` or ``columns`` still loads. The header keys newer Tiled added
+Tilesets (embedded, ``.tsx``, ``.tsj``) are read for what a level needs of them — tile
+classes, properties and collision shapes, which mark walls — by
+:func:`navmesh.tiled_tiles.read_tilesets` through the map's one bounded reader; their images
+are never opened, and a tileset written by an older Tiled without ``tilecount`` or
+``columns`` still loads. The header keys newer Tiled added
 (``infinite``, ``nextlayerid``, ``renderorder``, ``tiledversion``, ...) default as Tiled
 does. The map's bytes come from the caller (read once, bounded); the decoded document is
 checked and its object templates merged in by :func:`navmesh.tiled_guard.guard_map`, then
@@ -31,6 +32,7 @@ from pytiled_parser.parsers.tmx.properties import parse as parse_tmx_properties
 from navmesh.errors import LevelError
 from navmesh.tiled_format import is_tiled_xml
 from navmesh.tiled_guard import guard_map
+from navmesh.tiled_tiles import read_tilesets
 
 __all__ = ["ORTHOGONAL", "read_map"]
 
@@ -42,7 +44,7 @@ _LAYER_TAGS = ("layer", "objectgroup", "imagelayer", "group")
 
 
 def read_map(path: Path, raw: bytes, source: str) -> TiledMap:
-    """The map at ``path``, whose bytes are ``raw``, with ``tilesets`` empty; a map that is
+    """The map at ``path``, whose bytes are ``raw``, with its tilesets; a map that is
     not orthogonal or fails :func:`~navmesh.tiled_guard.guard_map` raises
     :class:`LevelError` (``source`` names it). Malformed input raises whatever the XML,
     JSON or layer readers raise (the caller turns it into one line)."""
@@ -57,7 +59,7 @@ def _read_tmx(path: Path, raw: bytes, source: str) -> TiledMap:
         raise ValueError(f"the XML's root element is <{root.tag}>, not <map>")
     attrib = root.attrib
     _check_orientation(attrib.get("orientation", ORTHOGONAL), source)
-    guard_map(root, path.parent, source)
+    files = guard_map(root, path.parent, source)
     tmap = _tiled_map(
         path, attrib,
         infinite=bool(int(attrib.get("infinite", "0"))),
@@ -68,6 +70,7 @@ def _read_tmx(path: Path, raw: bytes, source: str) -> TiledMap:
     properties = root.find("./properties")
     if properties is not None:
         tmap.properties = parse_tmx_properties(properties)
+    tmap.tilesets = read_tilesets(root, path.parent, files.read, source)
     return tmap
 
 
@@ -76,7 +79,7 @@ def _read_json(path: Path, raw: bytes, source: str) -> TiledMap:
     if not isinstance(data, dict):
         raise ValueError("the JSON is not an object")
     _check_orientation(data.get("orientation", ORTHOGONAL), source)
-    guard_map(data, path.parent, source)
+    files = guard_map(data, path.parent, source)
     layers = data.get("layers") or []
     tmap = _tiled_map(
         path, data,
@@ -90,6 +93,7 @@ def _read_json(path: Path, raw: bytes, source: str) -> TiledMap:
         tmap.properties = dict(properties)
     elif properties:
         tmap.properties = parse_json_properties(properties)
+    tmap.tilesets = read_tilesets(data, path.parent, files.read, source)
     return tmap
 
 

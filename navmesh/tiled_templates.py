@@ -11,8 +11,10 @@ template in the other format is converted (its attributes, shape and scalar prop
 class-typed properties, which a level never reads, are left out).
 
 Each template and its tileset are read through the map's one reader (``MapFiles``), so a
-FIFO, a device or a huge file is refused like any file a map names; the tileset is only
-checked, never parsed (a level needs no tile images). Every placed object counts its
+FIFO, a device or a huge file is refused like any file a map names. A template's tile object
+counts its gid in the template's own tileset: as in Tiled, it is moved to that tileset's
+place in the map (:class:`MapTilesets`), which gains the tileset if it lacks it, so the
+object's tile class and walls are those of its tile. Every placed object counts its
 template's size against :data:`navmesh.level_fields.MAX_FILE_BYTES`, so a small map cannot
 multiply a large template into unbounded work.
 """
@@ -20,6 +22,7 @@ multiply a large template into unbounded work.
 from __future__ import annotations
 
 import json
+import os
 import xml.etree.ElementTree as etree
 from pathlib import Path
 from typing import Any, Callable, NoReturn
@@ -28,9 +31,36 @@ from navmesh.errors import LevelError
 from navmesh.level_fields import MAX_FILE_BYTES
 from navmesh.tiled_format import is_tiled_xml
 
-__all__ = ["Templates"]
+__all__ = ["MapTilesets", "Templates"]
 
 _SHAPES = ("ellipse", "point", "polygon", "polyline", "text")
+_FLAGS = 0xF0000000  # a gid's flip and rotation flags
+_ADDED_FIRST, _ADDED_SPAN, _ADDED_MAX = 0x08000000, 0x00400000, 31
+"""Tilesets a map gains from its templates start at _ADDED_FIRST, _ADDED_SPAN gids apart: no
+map's own tilesets reach there (a 64 MiB file cannot list 2^27 tiles)."""
+
+
+class MapTilesets:
+    """The map's external tilesets by file, and the first gid of each; ``add(firstgid,
+    path)`` puts a template's tileset the map lacks into the map's document."""
+
+    def __init__(self, firstgids: dict[str, int], add: Callable[[int, str], None]) -> None:
+        self._firstgids = dict(firstgids)
+        self._add = add
+        self._added = 0
+
+    def firstgid(self, path: Path, source: str, field: str) -> int:
+        """The map's first gid of the tileset file ``path`` (added to the map if needed)."""
+        key = os.path.normpath(path)
+        if key not in self._firstgids:
+            if self._added >= _ADDED_MAX:
+                raise LevelError(source, field, f"the map's templates name more than "
+                                                f"{_ADDED_MAX} tilesets the map lacks")
+            first = _ADDED_FIRST + self._added * _ADDED_SPAN
+            self._added += 1
+            self._firstgids[key] = first
+            self._add(first, key)
+        return self._firstgids[key]
 
 
 class Templates:
@@ -40,16 +70,38 @@ class Templates:
     ``source`` names the map in errors.
     """
 
-    def __init__(self, read: Callable[[Path, str], bytes], source: str) -> None:
+    def __init__(self, read: Callable[[Path, str], bytes], source: str,
+                 tilesets: MapTilesets | None = None) -> None:
         self.read = read
         self.source = source
+        self.tilesets = tilesets
         self._decoded: dict[Path, Any] = {}
+        self._tileset_of: dict[Path, tuple[Path, int]] = {}
         self._expanded = 0
+
+    def _map_gid(self, gid: Any, template: Path, field: str) -> Any:
+        """A template's gid in the map's numbering (unchanged without a tileset to map)."""
+        if template not in self._tileset_of or self.tilesets is None:
+            return gid
+        try:
+            number = int(gid)
+        except (TypeError, ValueError):
+            return gid
+        if not 0 <= number < 2**32:
+            return gid
+        path, first = self._tileset_of[template]
+        local = (number & ~_FLAGS) - first
+        if local < 0:
+            return gid
+        return (number & _FLAGS) | (self.tilesets.firstgid(path, self.source, field) + local)
 
     def inline_json(self, obj: dict[str, Any], folder: Path, where: str) -> dict[str, Any]:
         """The JSON object ``obj`` with its template's keys merged in (no ``template`` key)."""
         template = self._load(obj.get("template"), folder, where, xml=False)
         merged = {k: v for k, v in template.items() if k not in ("id", "template")}
+        if "gid" in merged and "gid" not in obj:
+            merged["gid"] = self._map_gid(merged["gid"], folder / obj["template"],
+                                          f"{where} template")
         for key, value in obj.items():
             if key == "template":
                 continue
@@ -66,6 +118,9 @@ class Templates:
         template = self._load(obj.get("template"), folder, where, xml=True)
         merged = etree.Element("object", {k: v for k, v in template.attrib.items()
                                           if k not in ("id", "template")})
+        if merged.get("gid") is not None and obj.get("gid") is None:
+            merged.set("gid", str(self._map_gid(merged.get("gid"), folder / obj.get("template"),
+                                                f"{where} template")))
         merged.attrib.update((k, v) for k, v in obj.attrib.items() if k != "template")
         own = {child.tag for child in obj}
         for child in template:  # shared, not copied: nothing downstream changes them
@@ -98,6 +153,13 @@ class Templates:
             self._decoded[path] = self._decode(path, raw, field, xml)
         return self._decoded[path]
 
+    def _note_tileset(self, path: Path, named: str, first: Any) -> None:
+        """Remember the tileset (and its first gid there) a template counts its gid in."""
+        try:
+            self._tileset_of[path] = (path.parent / named, int(first))
+        except (TypeError, ValueError):
+            pass
+
     def _decode(self, path: Path, raw: bytes, field: str, xml: bool) -> Any:
         if not raw.strip():
             self._fail(field, f"{path} is empty")
@@ -119,6 +181,7 @@ class Templates:
             template = root.find("object") if root.tag == "template" else None
             tileset = root.find("tileset")
             named = tileset.get("source") if tileset is not None else None
+            first = tileset.get("firstgid", "1") if tileset is not None else None
             if template is None:
                 self._fail(field, f"{path} is not an object template (no <template> holding "
                                   "an <object>)")
@@ -130,12 +193,14 @@ class Templates:
             template = doc.get("object") if isinstance(doc, dict) else None
             tileset = doc.get("tileset") if isinstance(doc, dict) else None
             named = tileset.get("source") if isinstance(tileset, dict) else None
+            first = tileset.get("firstgid", 1) if isinstance(tileset, dict) else None
             if not isinstance(template, dict):
                 self._fail(field, f"{path} is not an object template (no \"object\")")
         if named is not None:
             if not isinstance(named, str):
                 self._fail(f"{field}'s tileset", f"source must be a file name, got {named!r}")
             self.read(path.parent / named, f"{field}'s tileset")
+            self._note_tileset(path, named, first)
         return template
 
     def _fail(self, field: str, problem: str) -> NoReturn:

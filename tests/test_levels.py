@@ -409,3 +409,22 @@ def assert_level_error(path: Path, field: str, words: str) -> None:
     assert message.startswith(f"{path}: {field}: "), message
     assert words in info.value.problem, message
     assert info.value.field == field
+
+
+def test_validate_a_level_of_many_holes_one_near_its_outline(tmp_path, capsys):
+    """More than LOCAL_MIN_HOLES obstacles, one of them closer to the outline than a body:
+    the body check's local path indexed the holes with numpy integers, which shapely
+    refuses (a TypeError traceback from ``stealth validate``; found loading a Tiled map
+    whose walled-off pockets issue 41 now blocks)."""
+    from headless.cli import main
+
+    pillars = [[[x + 0.4, y + 0.4], [x + 0.6, y + 0.4], [x + 0.6, y + 0.6], [x + 0.4, y + 0.6]]
+               for x in range(2, 14, 1) for y in range(2, 14, 1)]
+    near = [[0.3, 5.0], [0.5, 5.0], [0.5, 5.5], [0.3, 5.5]]  # 0.3 from the outline
+    level = {"format": "stealth-level/1", "name": "holes",
+             "outline": [[0, 0], [16, 0], [16, 16], [0, 16]],
+             "obstacles": [*pillars, near], "guards": [[1.5, 1.5]]}
+    path = tmp_path / "holes.json"
+    path.write_text(json.dumps(level))
+    assert main(["validate", str(path)]) == 0
+    assert "ok (holes" in capsys.readouterr().err

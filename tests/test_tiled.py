@@ -377,8 +377,10 @@ def _bad_maps(w: MapWriter) -> list[tuple[str, dict, str]]:
          "map: orientation 'hexagonal' is not supported"),
         ("non-square", w.map(20, 20, objs(guard()), tile_h=16),
          "map: tiles of 32x16 pixels are not supported"),
-        ("tile object", w.map(20, 20, objs(guard(), w.obj("guard", 40, 40, T, T, gid=1))),
-         r"layer 'things' object \d+ \(guard\): tile objects have no shape"),
+        ("unknown layer type", w.map(20, 20, [*objs(guard()), {
+            "id": 90, "name": "odd", "opacity": 1, "type": "foolayer", "visible": True,
+            "x": 0, "y": 0}]), r"layer 'odd': unknown layer type 'foolayer' \(Tiled's layer "
+                               r"types are tilelayer, objectgroup, imagelayer, group\)"),
         ("text guard", w.map(20, 20, objs(w.obj("guard", 40, 40, T, T, text={"text": "G"}))),
          r"object \d+ \(guard\): text objects have no shape"),
         ("polyline", w.map(20, 20, objs(guard(), w.obj("obstacle", 40, 40, polyline=[

@@ -421,15 +421,18 @@ def test_a_layer_or_chunk_of_no_tiles_is_read_as_empty(tmp_path):
     assert load_level(tmx(tmp_path, data=chunks, infinite=True)).occupancy.sum() == 206
 
 
-def test_a_tileset_is_checked_not_parsed(tmp_path):
-    """100,000 collision shapes in a tileset tile cost nothing: tilesets are never parsed."""
+def test_a_tile_of_100000_collision_shapes_is_refused_quickly(tmp_path):
+    """100,000 collision shapes on one tileset tile are one line, counted before the tileset
+    is parsed (issue 41: the loader hung for minutes on it)."""
     shapes = "".join(f'<object id="{i}" x="0" y="0" width="1" height="1"/>'
                      for i in range(1, 100_001))
     (tmp_path / "walls.tsx").write_text(
         '<?xml version="1.0"?><tileset name="w" tilewidth="32" tileheight="32" tilecount="1" '
         f'columns="1"><tile id="0"><objectgroup>{shapes}</objectgroup></tile></tileset>')
     start = time.monotonic()
-    load_level(tmx(tmp_path))
+    with pytest.raises(LevelError, match=r"tilesets\[0\] 'walls.tsx' tile 0: 100000 collision "
+                                         r"shapes on one tile, more than the limit of 256"):
+        load_level(tmx(tmp_path))
     assert time.monotonic() - start < 5
 
 

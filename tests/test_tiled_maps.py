@@ -32,6 +32,9 @@ LOADS = {
     "tiled_examples/sewers.tmx": (50, 50, [NO_GUARD, f"{EMPTY} (50x50 tiles)"]),
     "tiled_examples/perspective_walls.tmx": (32, 32, [
         NO_GUARD, "2 walkable cells in 2 pockets walled off from the rest"]),
+    "tiled_examples/sewer_automap/rule_001.tmx": (3, 7, [  # TMX 1.0: objects without id
+        "object 1 'StinkingAcid' (dmg): unknown class 'DMG', treated as decoration",
+        NO_GUARD, f"{EMPTY} (7x3 tiles)"]),
     "pytiled_parser/layer_tests/all_layer_types/map.json": (6, 8, [NO_GUARD, f"{EMPTY} (8x6 tiles)"]),
     "pytiled_parser/layer_tests/b64_zstd/map.tmx": (6, 8, [NO_GUARD, f"{EMPTY} (8x6 tiles)"]),
     "pytiled_parser/layer_tests/infinite_map/map.json": (7, 9, [NO_GUARD, f"{EMPTY} (infinite)"]),
@@ -39,7 +42,7 @@ LOADS = {
     "arcade/test_objects.json": (20, 20, [
         "object 7 'crate1' (crate): unknown class 'crate', treated as decoration",
         "object 8 'coin1' (coin): unknown class 'coin', treated as decoration",
-        NO_GUARD, f"{EMPTY} (20x20 tiles)"]),
+        NO_GUARD]),  # its two tile objects of a tile with a collision polygon block
 }
 REFUSED = {
     "tiled_examples/hexagonal-mini.tmx": "map: orientation 'hexagonal' is not supported",
@@ -209,3 +212,40 @@ def test_a_broken_copy_of_a_published_map_is_a_one_line_error(tmp_path, name):
                 load_level(path)
             except LevelError as error:
                 assert "\n" not in str(error)
+
+
+def _collision_conventions(path: Path) -> list[str]:
+    """What in a map marks walls the ways Tiled users do (issue 41): layers named or of a
+    wall class, tiles of such a class, with a collides-style property, or collision shapes."""
+    from pytiled_parser import layer as tl
+
+    from navmesh.tiled_classes import WALL_CLASSES, WALL_PROPERTIES
+    from navmesh.tiled_read import read_map
+
+    tmap = read_map(path, path.read_bytes(), str(path))
+    found = []
+
+    def walk(layers):
+        for layer in layers:
+            if {layer.name.strip().lower(), (layer.class_ or "").lower()} & set(WALL_CLASSES):
+                found.append(f"layer {layer.name}")
+            if isinstance(layer, tl.LayerGroup):
+                walk(layer.layers or [])
+    walk(tmap.layers)
+    for tileset in tmap.tilesets.values():
+        for tile in (tileset.tiles or {}).values():
+            if (tile.class_ or "").lower() in WALL_CLASSES or tile.objects is not None or any(
+                    str(k).lower() in WALL_PROPERTIES for k in (tile.properties or {})):
+                found.append(f"tileset {tileset.name} tile {tile.id}")
+    return found
+
+
+@pytest.mark.parametrize("name", sorted(LOADS))
+def test_no_published_map_with_a_collision_convention_is_an_empty_box(name):
+    conventions = _collision_conventions(HELD / name)
+    empty = any(EMPTY in part for part in LOADS[name][2])
+    assert empty == (not conventions), conventions
+    if conventions:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            assert not load_level(HELD / name).occupancy.all()

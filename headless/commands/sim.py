@@ -1,6 +1,9 @@
 """``stealth sim``: one trial, its metrics printed (SPEC §9), optionally its trace.
 
-The level and the config are loaded and checked once, here, and handed to the trial. With
+The level and the config are loaded and checked once, here, and handed to the trial. A Tiled
+map that places guards (objects of class ``guard``) runs with ``world.spawns = "level"`` unless
+``world.spawns`` is given: the designer put them there (its guards' ``facing`` and ``patrol``
+properties apply with it). With
 ``--set world.engine=batch`` the trial runs on the batch engine
 (``game.batch.run_trials([spec])[0]``, the same row), refused in one line when that engine
 does not cover it or a trace is asked for (it writes none).
@@ -16,7 +19,7 @@ from typing import Any
 from ai.stimuli import load_stimulus
 from game.config import ENGINE_KEY, Config, parse_overrides
 from game.config_file import read_config_file
-from game.trial import TrialSpec, make_world, run_trial, sim_document
+from game.trial import TrialSpec, make_world, placed_spawns, run_trial, sim_document
 from navmesh.level import load_level, resolve_level_path
 
 from ..engines import BATCH, check_covered, refusal
@@ -47,6 +50,8 @@ def cmd_sim(args: argparse.Namespace) -> int:
     for plugin in args.stimulus:  # before the level: a plugin may declare its zone kinds
         load_stimulus(plugin)  # a bad plugin fails here with its one-line message
     level = load_level(args.level)  # a bad level fails here with its one-line message
+    overrides = placed_spawns(level, _settings(
+        args.set, read_config_file(args.config) if args.config else {}))
     spec = TrialSpec(
         level=args.level,
         abstraction=args.abstraction,
@@ -54,7 +59,7 @@ def cmd_sim(args: argparse.Namespace) -> int:
         player=args.player,
         scenario=args.scenario,
         seed=args.seed,
-        overrides=_settings(args.set, read_config_file(args.config) if args.config else {}),
+        overrides=overrides,
         stimuli=tuple(args.stimulus),
     )
     config = Config.load(spec.settings)  # every key and value checked: one-line ConfigError
