@@ -102,6 +102,9 @@ WORLD: Mapping[str, Bound] = {
     "fov_deg": Range(0.0, 360.0),
     "attack_range": NON_NEGATIVE,
     "attack_needs_line_of_sight": FLAG,
+    # the game's rule (stealth play's [play.world]); off: the paper's l. 206
+    "attack_needs_awareness": FLAG,
+    "attack_memory": NON_NEGATIVE,
     "stuck_timeout": POSITIVE,
     "engine": OneOf(ENGINES),
 }

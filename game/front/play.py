@@ -1,7 +1,10 @@
 """``stealth play``: the interactive game (pygame-ce window, keyboard and mouse).
 
 The world is built like a headless trial (:func:`game.trial.make_world`) with the
-interactive physics step (1/60 s), the level's own guard spawns (SPEC §6) and, by default,
+interactive physics step (1/60 s), play's own defaults (the ``[play.*]`` tables of
+game/defaults.toml, :func:`game.config.play_defaults`: the level's own guard spawns (SPEC §6),
+guards that hurt only a player they noticed, the awareness marker, a take-down reach beyond
+the attack range; ``--set`` overrides them) and, by default,
 the capture scenario: the game is over when the player's HP reaches 0 (or after the
 trial's duration, 60 s by default: the player survived). Enter restarts, 1–5 restart with
 another guard mode on the same level and seed.
@@ -96,7 +99,7 @@ class PlayGame(FrameLoop):
         self.settings = settings
         self.lockstep = lockstep
         self.on_session = on_session
-        self.config = Config.load({"world.spawns": "level"}).with_overrides(settings.overrides)
+        self.config = Config.for_play(settings.overrides)  # [play.*], then --set
         self.autopilot = settings.autopilot
         self.overlay = overlay_key(settings.overlay)
         self.show_mesh, self.show_plans = settings.show_mesh, settings.show_plans
@@ -173,12 +176,12 @@ class PlayGame(FrameLoop):
         return world
 
     def identity_overrides(self) -> tuple[tuple[str, Any], ...]:
-        """The config changes a session is played with (its trial identity's overrides)."""
-        from game.config import parse_overrides
+        """The config changes a session is played with (its trial identity's overrides):
+        play's own defaults (``[play.*]``), then the keys of ``--set``."""
+        from game.config import parse_overrides, play_defaults
 
-        keys = dict.fromkeys(k for k, _ in parse_overrides(self.settings.overrides))
-        return (("world.spawns", "level"),) + tuple(
-            (k, self.config[k]) for k in keys if k != "world.spawns")
+        keys = dict.fromkeys([*play_defaults(), *(k for k, _ in parse_overrides(self.settings.overrides))])
+        return tuple((k, self.config[k]) for k in keys)
 
     def restart(self, mode: str | None = None) -> None:
         """A fresh world on the same level and seed (optionally with another guard mode)."""

@@ -66,7 +66,7 @@ def cmd_play(args: argparse.Namespace, on_session: SessionSink | None = None) ->
         raise FrontError(f"--frames: expected a positive number of frames, got {args.frames}")
     from game.config import Config
 
-    config = Config.load({"world.spawns": "level"}).with_overrides(args.set)  # bad --set: one line
+    config = Config.for_play(args.set)  # bad --set: one line
     if loaded is not None:
         from game.schema import check_level
 

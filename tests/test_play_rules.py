@@ -1,0 +1,204 @@
+"""``stealth play``'s own rules (issue 42), on a headless World and through the real front
+under Xvfb: a guard hurts only a player it noticed (sees now, or saw within
+``world.attack_memory``), the take-down reaches beyond the attack range, and none of it
+reaches the headless defaults or the ``paper`` preset."""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+import shutil
+import subprocess
+import sys
+import textwrap
+from pathlib import Path
+
+import pytest
+
+from ai.view import GuardAI
+from game.config import Config, play_defaults
+from game.world import World
+from navmesh.level import parse_level
+
+ROOT = Path(__file__).resolve().parent.parent
+
+
+class StayGuards(GuardAI):
+    """Guards that never move (so only the heading says where they look)."""
+
+    mode = "stay"
+
+    def reset(self, graph, rng, n_guards) -> None:  # type: ignore[no-untyped-def]
+        pass
+
+    def decide(self, i, view) -> int:  # type: ignore[no-untyped-def]
+        return int(view.guard_nodes[i])
+
+
+ROOM = {"format": "stealth-level/1", "name": "room",
+        "grid": ["#" * 11] + ["#" + "." * 9 + "#" for _ in range(9)] + ["#" * 11],
+        "guards": [[5.5, 2.5]], "player": [8.5, 8.5]}
+
+
+def _world(config: Config) -> World:
+    world = World(parse_level(ROOM, "room.json"), "grid", StayGuards(), None, config=config,
+                  scenario="capture", seed=0, interactive=True)
+    world.player_input = (0.0, 0.0)
+    return world
+
+
+def _put(world: World, xy: tuple[float, float], heading: float) -> None:
+    """The player at ``xy``; guard 0 at (5.5, 2.5) facing ``heading``."""
+    world.player.place(xy)
+    world.player.node = world.graph.node_at(*xy)
+    world.guards[0].heading = heading
+
+
+def _run(world: World, seconds: float, heading: float | None = None) -> None:
+    for _ in range(round(seconds / world.dt)):
+        if heading is not None:
+            world.guards[0].heading = heading
+        world.step()
+
+
+PLAY = Config.for_play(["world.player_hp=3"])
+PAPER = Config.load({"world.spawns": "level", "world.player_hp": 3.0})
+
+
+def test_an_unaware_guard_in_range_does_no_damage_under_play_rules() -> None:
+    """The player 1.0 behind a guard facing away (inside the 1.5 attack range): no damage in
+    5 s with play's rules; the paper's rule (the headless default) hurts at once."""
+    for config, hurt in ((PLAY, False), (PAPER, True)):
+        world = _world(config)
+        _put(world, (4.5, 2.5), heading=0.0)  # the guard faces +x, the player is at -x
+        _run(world, 5.0, heading=0.0)
+        assert world.seen_by == ()
+        assert (world.hp < world.hp_max) is hurt, (config["world.attack_needs_awareness"], world.hp)
+    assert world.done  # the paper's guard took all 3 HP in 3 s
+
+
+def test_a_guard_that_noticed_hurts_and_stops_after_its_memory() -> None:
+    """Facing the player it detects (after the awareness rises) and hurts; turned away it
+    hurts for at most ``world.attack_memory`` more seconds after its last detection."""
+    world = _world(Config.for_play(["world.player_hp=100"]))
+    _put(world, (4.5, 2.5), heading=math.pi)  # facing the player
+    _run(world, 3.0, heading=math.pi)
+    assert world.seen_by == (0,) and world.hp < world.hp_max
+    last_seen = world.t
+    hp_turning = world.hp
+    memory = float(world.config["world.attack_memory"])
+    _run(world, memory + 2.0, heading=0.0)  # turned away (awareness may linger, then fades)
+    assert world.seen_by == ()
+    hp = world.hp
+    _run(world, 3.0, heading=0.0)
+    assert world.hp == hp < hp_turning  # it hurt on after turning, then stopped
+    assert world.health.damage_steps * world.dt <= (world.t - last_seen) + 3.0 + 1e-9
+
+
+def test_a_take_down_from_behind_reaches_beyond_the_attack_range() -> None:
+    """1.8 behind the guard: outside its 1.5 attack range, inside play's 2.0 reach; the
+    headless reach (1.0) refuses it."""
+    world = _world(PLAY)
+    _put(world, (3.7, 2.5), heading=0.0)
+    assert math.dist(world.player.pos, world.guards[0].pos) > world.attack_range
+    assert world.take_down() is True and not world.guards[0].active
+    world = _world(PAPER)
+    _put(world, (3.7, 2.5), heading=0.0)
+    assert world.take_down() == "no guard within reach from behind"
+
+
+def test_play_defaults_reach_neither_the_headless_defaults_nor_the_paper_preset() -> None:
+    from headless.presets import load_preset
+
+    paper = load_preset("paper")
+    for config in (Config.defaults().as_dict(), paper.config):
+        assert config["world.attack_needs_awareness"] is False
+        assert config["awareness.enabled"] is False
+        assert config["stimuli.takedown_range"] == 1.0
+    assert paper.config_hash == "7647327243295999"  # as pinned before the play keys
+    assert set(play_defaults()) == {"world.spawns", "world.attack_needs_awareness",
+                                    "awareness.enabled", "stimuli.takedown_range"}
+    assert Config.for_play(["world.attack_needs_awareness=false"])[
+        "world.attack_needs_awareness"] is False  # --set still wins
+
+
+def test_the_batch_engine_refuses_plays_rule() -> None:
+    from game.trial import TrialSpec
+    from headless.engines import check_covered
+    from headless.errors import UserError
+
+    spec = TrialSpec("miami", "grid", "pf", "maxmin", "capture", 0,
+                     overrides=(("world.attack_needs_awareness", True),))
+    with pytest.raises(UserError, match="attack_needs_awareness"):
+        check_covered([spec])
+
+
+# ---------------------------------------------------------------- the real front (Xvfb)
+
+_MISSING = [tool for tool in ("Xvfb",) if shutil.which(tool) is None]
+
+_SESSION = textwrap.dedent("""
+    import json, math, sys
+    from game.front.play import PlayGame, PlaySettings
+    from game.front.render import pygame
+    sys.path.insert(0, {tests!r})
+    from test_play_rules import StayGuards
+
+    level, behind = sys.argv[1], float(sys.argv[2])
+    game = PlayGame(PlaySettings(level, guards="random", overrides=tuple(sys.argv[3:])),
+                    lockstep=False, size=(960, 640))
+    assert pygame.display.get_driver() == "x11", pygame.display.get_driver()
+    world = game.world
+    world.guard_ai = StayGuards()
+    guard = world.guards[0]
+    for other in world.guards[1:]:
+        world.down_guard(world.guards.index(other))  # one guard only: the scripted one
+    world.player.place((guard.pos[0] - behind, guard.pos[1]))
+    world.player.node = world.graph.node_at(*world.player.pos)
+    guard.waypoints.clear()
+    game.start()
+    out = {{"hp": [], "t": []}}
+    for _ in range(90):  # about 1.5 s of game time, in real time
+        guard.heading = 0.0  # facing away from the player, at -x
+        guard.waypoints.clear()
+        game.frame(1 / 60)
+        out["hp"].append(world.hp)
+    pygame.event.post(pygame.event.Event(pygame.KEYDOWN, key=pygame.K_f, mod=0, unicode="f"))
+    game.frame(1 / 60)
+    out.update(active=guard.active, message=game.message, t=world.t, hp_max=world.hp_max,
+               played=dict(game.sound.played))
+    game.close()
+    print(json.dumps(out))
+""")
+
+
+@pytest.mark.skipif(bool(_MISSING) and not os.environ.get("CI"), reason="needs Xvfb")
+@pytest.mark.parametrize("overrides, hurt", [((), False),
+                                             (("world.attack_needs_awareness=false",), True)])
+def test_the_real_front_an_unaware_guard_does_no_damage_and_a_take_down_works(
+        overrides: tuple[str, ...], hurt: bool, tmp_path: Path) -> None:
+    """``stealth play``'s window (X11 on Xvfb): the player 1.2 behind a guard that faces
+    away for 1.5 s of game time takes no damage, and F takes the guard down (1.2 is
+    inside the 1.5 attack range: with the paper's rule set back, the same guard hurts)."""
+    from game.front.xvfb import xvfb
+
+    level = json.loads((ROOT / "examples" / "heist.json").read_text())
+    guard = level["guards"][0]
+    level.update(name="behind", guards=[guard], player=[guard[0] - 1.2, guard[1]])
+    path = tmp_path / "behind.json"
+    path.write_text(json.dumps(level))
+    (tmp_path / "script.py").write_text(_SESSION.format(tests=str(ROOT / "tests")))
+    with xvfb() as display:
+        env = {**os.environ, "DISPLAY": display, "PYTHONPATH": str(ROOT),
+               "SDL_AUDIODRIVER": "dummy", "STEALTHFIELD_DATA": str(tmp_path)}
+        env.pop("SDL_VIDEODRIVER", None)
+        done = subprocess.run([sys.executable, str(tmp_path / "script.py"), str(path), "1.2",
+                               *overrides], env=env, capture_output=True, text=True, timeout=120)
+    assert done.returncode == 0, done.stderr
+    out = json.loads(done.stdout.splitlines()[-1])
+    assert out["t"] > 1.0  # the session ran
+    assert (min(out["hp"]) < out["hp_max"]) is hurt
+    if not hurt:
+        assert out["active"] is False and out["message"] == "take down: done"
+
