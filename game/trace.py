@@ -102,10 +102,12 @@ class TraceWriter:
         self.handle.write(json.dumps(record) + "\n")
         self.last_t = record["t"]
 
-    def finish(self, world: World) -> None:
-        """Write the final state, unless the last AI tick already wrote this moment."""
-        if self.last_t is None or _round(world.t) != self.last_t:
-            self.write(world, {"final": True})
+    def finish(self, world: World, outcome: str = "") -> None:
+        """Write the final state, unless the last AI tick already wrote this moment;
+        ``outcome`` (a played session's: ``"caught"``, ``"won"``, ...) goes on it, in a line
+        of its own when the tick wrote the moment."""
+        if self.last_t is None or _round(world.t) != self.last_t or outcome:
+            self.write(world, {"final": True, **({"outcome": outcome} if outcome else {})})
 
 
 def attach_trace(world: World, handle: IO[str], *, explain: bool = False) -> TraceWriter:
@@ -152,6 +154,8 @@ class TraceLine:
     markers: tuple[int, ...] = ()
     #: the team's alert phase, if traced ("" otherwise)
     phase: str = ""
+    #: how a played session ended (``"caught"``, ``"won"``, ...), on its final line only
+    outcome: str = ""
 
 
 @dataclass(frozen=True)
@@ -259,6 +263,7 @@ def parse_line(record: Any, where: str) -> TraceLine:
         guards=tuple(guards),
         events=events,
         phase=str(record.get("phase") or ""),
+        outcome=str(record["outcome"])[:20] if isinstance(record.get("outcome"), str) else "",
     )
 
 

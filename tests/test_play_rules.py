@@ -202,3 +202,63 @@ def test_the_real_front_an_unaware_guard_does_no_damage_and_a_take_down_works(
     if not hurt:
         assert out["active"] is False and out["message"] == "take down: done"
 
+
+# ---------------------------------------------------------------- replay to the true end
+
+
+def test_a_replay_of_a_caught_session_ends_caught_at_its_capture_time(tmp_path: Path) -> None:
+    """A recorded game caught between two AI ticks (cheat guards, 0.3 HP): its trace ends
+    with the capture's moment, and ``stealth replay`` of it ends CAUGHT there, HP 0 (it
+    stopped at the last whole tick, "END OF TRACE", with HP left)."""
+    os.environ.setdefault("SDL_VIDEODRIVER", "dummy")
+    os.environ.setdefault("SDL_AUDIODRIVER", "dummy")
+    from game.front.play import PlayGame, PlaySettings
+    from game.front.replay import ReplayViewer
+    from game.trace import load_trace
+    from navmesh.level import load_level
+
+    got: list[tuple[dict, list[str]]] = []
+    game = PlayGame(PlaySettings("tlou", guards="cheat", record=True,
+                                 overrides=("world.player_hp=0.3",)),
+                    lockstep=True, size=(960, 800), on_session=lambda r, t: got.append((r, list(t))))
+    try:
+        game.start()
+        while not game.world.done:
+            game.run(30)
+        game.run(1)
+        capture = game.world.t
+    finally:
+        game.close()
+    (row, lines), = got
+    assert row["metrics"]["outcome"] == "caught"
+    assert round(capture, 6) % 1.0 != 0  # between two AI ticks (1 s apart)
+    path = tmp_path / "session.jsonl"
+    path.write_text("".join(line + "\n" for line in lines))
+    trace = load_trace(path)
+    assert trace.lines[-1].t == pytest.approx(capture, abs=1e-6)
+    assert trace.lines[-1].outcome == "caught" and trace.lines[-1].hp == pytest.approx(0, abs=1e-6)
+    viewer = ReplayViewer(trace, load_level("tlou"), "grid", lockstep=True, speed=32.0,
+                          config=game.config)
+    frames = int(capture * 60 / 32) + 5
+    viewer.run(frames)
+    assert viewer.t == pytest.approx(capture, abs=1e-6)
+    assert viewer.ending() == ("CAUGHT", "caught")
+    assert viewer.playback.state(viewer.t)[4] == pytest.approx(0, abs=1e-6)  # HP 0 at the end
+
+
+def test_a_headless_trace_of_a_capture_ends_caught_in_the_replay(tmp_path: Path) -> None:
+    """``stealth sim --trace`` already wrote the final moment; its replay names it."""
+    os.environ.setdefault("SDL_VIDEODRIVER", "dummy")
+    from game.front.replay import ReplayViewer
+    from game.trace import load_trace
+    from game.trial import TrialSpec, run_trial
+    from navmesh.level import load_level
+
+    path = tmp_path / "t.jsonl"
+    with path.open("w") as handle:
+        row = run_trial(TrialSpec("tlou", "grid", "cheat", "maxmin", "capture", 0,
+                                  overrides=(("world.player_hp", 0.3),)), trace=handle)
+    trace = load_trace(path)
+    viewer = ReplayViewer(trace, load_level("tlou"), "grid", lockstep=True)
+    assert row["metrics"]["captured"] is True
+    assert viewer.ending() == ("CAUGHT", "caught") and trace.lines[-1].outcome == ""

@@ -298,6 +298,18 @@ class ReplayViewer(FrameLoop):
             phase=line.phase,
         )
 
+    def ending(self) -> tuple[str, str]:
+        """The banner at the trace's end and its kind: a played session's outcome (its final
+        line says), a capture (HP 0 on the last line), else ``"END OF TRACE"``."""
+        last = self.playback.lines[-1]
+        titles = {"caught": "CAUGHT", "won": "ESCAPED", "survived": "SURVIVED",
+                  "time up": "TIME UP"}
+        if last.outcome:
+            return titles.get(last.outcome, last.outcome.upper()), last.outcome
+        if last.hp <= 0:
+            return "CAUGHT", "caught"
+        return "END OF TRACE", ""
+
     def frame(self, elapsed: float) -> None:
         """One frame: events, playback clock, drawing, flip."""
         for event in pygame.event.get():
@@ -309,13 +321,15 @@ class ReplayViewer(FrameLoop):
             self.t = min(self.t + step, self.playback.end)
         scene = self.scene()
         ended = self.t >= self.playback.end
+        banner, color = self.ending()
         info = [f"speed ×{self.speed:g}", f"tick {self.playback.index(self.t + 1e-9) + 1}/{len(self.playback.times)}"]
         if scene.events:
             info.append("events: " + ", ".join(scene.events))
         options = DrawOptions(
             show_mesh=self.show_mesh, show_plans=self.show_plans, paused=self.paused and not ended,
             help=self.HELP, info=info, legend=False,
-            banner="END OF TRACE" if ended else None, banner_sub="Home restart · Left step back · Esc quit",
+            banner=banner if ended else None,
+            banner_sub=f"at {self.playback.end:.1f} s · Home restart · Left step back · Esc quit",
         )
         self.follow()
         self.renderer.draw(self.screen, scene, options)
