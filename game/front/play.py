@@ -9,7 +9,10 @@ the capture scenario: the game is over when the player's HP reaches 0 (or after 
 trial's duration, 60 s by default: the player survived). Enter restarts, 1–5 restart with
 another guard mode on the same level and seed.
 
-With a real display the game runs in real time. With ``--frames N`` or under
+With a real display the game runs in real time: the world advances in fixed 1/60-s steps,
+as many a frame as the wall clock says (catch-up, at most :data:`MAX_CATCH_UP` s a frame),
+and a frame that had to run more than :data:`SKIP_DRAW_STEPS` steps skips its drawing
+(never two frames in a row), so slow drawing costs pictures, not game time. With ``--frames N`` or under
 ``SDL_VIDEODRIVER=dummy`` it runs in lockstep: exactly one physics step per frame, as
 fast as the machine allows (``N`` frames = ``N/60`` s of game time), so tests, benchmarks
 and screenshots are reproducible.
@@ -67,8 +70,11 @@ _MOVE_KEYS: tuple[tuple[int, float, float], ...] = (
     (pygame.K_d, 1.0, 0.0), (pygame.K_RIGHT, 1.0, 0.0),
 )
 
-#: At most this many physics steps per frame in real time (a slow frame slows the game).
-MAX_STEPS_PER_FRAME = 6
+#: The most game time one frame catches up in real time (s): a longer stall (the window
+#: dragged, the machine suspended) is lost rather than replayed in one burst.
+MAX_CATCH_UP = 0.5
+#: A frame that ran more steps than this skips its drawing (never two in a row).
+SKIP_DRAW_STEPS = 2
 MESSAGE_SECONDS = 2.5
 
 
@@ -117,6 +123,9 @@ class PlayGame(FrameLoop):
         #: the frame's extra work, sized by its measured budget (see :meth:`frame`)
         self.work = WorkAhead()
         self.best = BestResults()
+        #: frames whose drawing was skipped to catch up (real time only), and whether the
+        #: last one was
+        self.skipped_draws, self._skipped_last = 0, False
         self._load(settings.level, settings.guards)
         _freeze_heap()
 
@@ -377,28 +386,34 @@ class PlayGame(FrameLoop):
         if "escaped" in events:
             self.world.stop()
 
-    def update(self, elapsed: float) -> None:
-        """Advance the world: one step in lockstep, else ``elapsed`` seconds of game time."""
+    def update(self, elapsed: float) -> int:
+        """Advance the world: one step in lockstep, else ``elapsed`` seconds of game time in
+        fixed steps (what is left of a step waits for the next frame); returns the steps run."""
         if self.paused or self.state in ("over", "questions"):
             self._accumulator = 0.0
             if self._store_when_ready and self.world.m.distances_ready():
                 self._store_when_ready = False
                 self._close_session(self.outcome)
                 self.flash("session recorded", GOOD)
-            return
+            return 0
         self._steer()
         if self.state == "ready":
-            return
+            return 0
+        steps = 0
         if self.lockstep:
             self._step()
+            steps = 1
         else:
-            self._accumulator = min(self._accumulator + elapsed, MAX_STEPS_PER_FRAME * self.world.dt)
-            while self._accumulator >= self.world.dt and not self.world.done:
+            self._accumulator = min(self._accumulator + elapsed, MAX_CATCH_UP)
+            dt = self.world.dt
+            while self._accumulator >= dt - 1e-9 and not self.world.done:
                 self._step()
-                self._accumulator -= self.world.dt
+                steps += 1
+                self._accumulator -= dt
         self.rings.observe(self.world)
         if self.world.done:
             self._game_over()
+        return steps
 
     def panel(self) -> Panel | None:
         """The screen over the map now (ready, questionnaire, game over), if any."""
@@ -450,7 +465,14 @@ class PlayGame(FrameLoop):
             self.handle(event)
         if not self.running:
             return
-        self.update(elapsed)
+        steps = self.update(elapsed)
+        if steps > SKIP_DRAW_STEPS and not self._skipped_last and not self.lockstep:
+            # behind the wall clock: this frame's time goes to the simulation, not a picture
+            self.skipped_draws += 1
+            self._skipped_last = True
+            self.work.after_frame(self.world, time.perf_counter() - start, self.idle())
+            return
+        self._skipped_last = False
         self.work.before_draw(self.renderer.layers)
         scene = self.draw()
         if self.state == "playing" and not self.paused:
