@@ -47,7 +47,8 @@ IDENTITY_NEUTRAL: frozenset[str] = frozenset({ENGINE_KEY})
 #: keys added after stores were written whose default is the older behaviour: out of
 #: :meth:`Config.hash` while at their default, so those stores keep their hash and resume
 NEUTRAL_AT_DEFAULT: frozenset[str] = frozenset({"world.attack_needs_awareness",
-                                                "world.attack_memory"})
+                                                "world.attack_memory", "world.sneak_factor",
+                                                "awareness.gait_sneak"})
 
 #: the table of ``stealth play``'s own defaults (:func:`play_defaults`), no section of keys
 PLAY_TABLE = "play"

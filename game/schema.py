@@ -96,6 +96,7 @@ WORLD: Mapping[str, Bound] = {
     "guard_speed": PlayerParams.bounds["guard_speed"],
     "player_speed": PlayerParams.bounds["player_speed"],
     "sprint_factor": POSITIVE,
+    "sneak_factor": POSITIVE,
     # and below half the level's cell size: check_level
     "agent_radius": POSITIVE,
     "view_range": NON_NEGATIVE,

@@ -84,6 +84,7 @@ class World(PlayerActions):
         self.hp_max = float(w["player_hp"])
         self.stuck_timeout = float(w["stuck_timeout"])
         self.sprint_factor = float(w["sprint_factor"])
+        self.sneak_factor = float(w["sneak_factor"])
         # Zones (SPEC §5) say what they do to confidence decay and view range (game.zones).
         zone_map = ZoneMap.build(level, self.graph, config)
         self.zone_rules, self.zones, self.view_scale_at = (
@@ -105,6 +106,8 @@ class World(PlayerActions):
         self.sighting: int | None = None
         self.seen_by: tuple[int, ...] = ()
         self.sprinting = False
+        #: the slow walk (stealth play): speed x sneak_factor, the "sneak" gait
+        self.sneaking = False
         self._sprinted = False
         self.player_moved = False
         self.player_input: tuple[float, float] | None = None
@@ -256,8 +259,10 @@ class World(PlayerActions):
         return player_speed
 
     def player_step_speed(self) -> float:
-        """The player's speed this step (sprinting or not)."""
-        return self.player_speed * (self.sprint_factor if self.sprinting else 1.0)
+        """The player's speed this step (sprinting, walking slowly or neither)."""
+        if self.sprinting:
+            return self.player_speed * self.sprint_factor
+        return self.player_speed * (self.sneak_factor if self.sneaking else 1.0)
 
     def speeds(self, player_speed: float) -> list[float]:
         """The speed each agent walks at this step: the guards', then the player's."""

@@ -55,13 +55,17 @@ from game.trial import TrialSpec
 from game.world import World
 
 
-#: Stealth mechanics: the World method each input calls, and the label of its messages.
-MECHANICS: dict[str, tuple[Callable[..., Any], str]] = {
-    "throw_decoy": (World.throw_decoy, "throw decoy"),
-    "activate_decoy": (World.activate_decoy, "activate decoy"),
-    "take_down": (World.take_down, "take down"),
-    "toggle_rain": (World.toggle_rain, "rain"),
+#: Stealth mechanics: the World method each input calls, the label of its messages and the
+#: sound of its success ("" : the sound board hears it in the world: take-down, rain).
+MECHANICS: dict[str, tuple[Callable[..., Any], str, str]] = {
+    "throw_decoy": (World.throw_decoy, "throw decoy", "throw"),
+    "activate_decoy": (World.activate_decoy, "activate decoy", "decoy_on"),
+    "take_down": (World.take_down, "take down", ""),
+    "toggle_rain": (World.toggle_rain, "rain", ""),
 }
+
+#: The pause menu (Esc): its entries, in order.
+MENU = ("Resume", "Restart", "Volume", "Controls", "Quit")
 
 _MOVE_KEYS: tuple[tuple[int, float, float], ...] = (
     (pygame.K_w, 0.0, -1.0), (pygame.K_UP, 0.0, -1.0),
@@ -110,6 +114,10 @@ class PlayGame(FrameLoop):
         self.overlay = overlay_key(settings.overlay)
         self.show_mesh, self.show_plans = settings.show_mesh, settings.show_plans
         self.paused = False
+        #: the pause menu's highlighted entry (None: closed); ``controls``: its key list shown
+        self.menu: int | None = None
+        self.controls = False
+        self._paused_before_menu = False
         self.running = True
         self.message, self.message_color, self._message_until = "", WARN, 0.0
         self.camera = Camera()
@@ -267,20 +275,26 @@ class PlayGame(FrameLoop):
         return [f"{keys} {what.split(' (')[0]}" for keys, what in key_help()]
 
     def _mechanic(self, method: str, *args: float) -> None:
-        action, label = MECHANICS[method]
+        action, label, sound = MECHANICS[method]
         if self.world.done or self.state != "playing":
             return
         try:
             result = action(self.world, *args)
         except (ValueError, RuntimeError) as error:
             self.flash(f"{label}: {error}", BAD)
+            self.sound.play("denied")
             return
+        done = bool(result) if isinstance(result, str) else result is None or bool(result)
         if isinstance(result, str):  # a refusal is a str that is false (game.world.Refused)
             self.flash(f"{label}: {result}", GOOD if result else BAD)
-        elif result is None or result:
+        elif done:
             self.flash(f"{label}: done", GOOD)
         else:
             self.flash(f"{label}: not possible now", BAD)
+        if not done:
+            self.sound.play("denied")
+        elif sound:
+            self.sound.play(sound)
 
     def handle(self, event: pygame.event.Event) -> None:
         """React to one pygame event."""
@@ -296,12 +310,56 @@ class PlayGame(FrameLoop):
         elif event.type == pygame.KEYDOWN:
             self._key(event.key)
 
+    def open_menu(self) -> None:
+        """Esc: the pause menu, the game paused under it."""
+        if self.menu is None:
+            self._paused_before_menu = self.paused
+        self.menu, self.controls, self.paused = 0, False, True
+
+    def close_menu(self) -> None:
+        """Resume: the menu closed, the game as paused as it was before."""
+        self.menu, self.controls, self.paused = None, False, self._paused_before_menu
+
+    def _menu_key(self, key: int) -> None:
+        """Keys while the pause menu is open: Up / Down choose, Enter takes, Left / Right
+        set the volume, Esc resumes (or leaves the controls list), Q quits."""
+        assert self.menu is not None
+        if self.controls:
+            if key in (pygame.K_ESCAPE, pygame.K_RETURN, pygame.K_KP_ENTER, pygame.K_BACKSPACE):
+                self.controls = False
+            return
+        entry = MENU[self.menu]
+        if key == pygame.K_ESCAPE:
+            self.close_menu()
+        elif key in (pygame.K_UP, pygame.K_w, pygame.K_DOWN, pygame.K_s):
+            step = -1 if key in (pygame.K_UP, pygame.K_w) else 1
+            self.menu = (self.menu + step) % len(MENU)
+        elif key in (pygame.K_LEFT, pygame.K_a, pygame.K_RIGHT, pygame.K_d) and entry == "Volume":
+            self.sound.change_volume(0.1 if key in (pygame.K_RIGHT, pygame.K_d) else -0.1)
+            self.sound.play("step")  # hear the new volume
+        elif key in (pygame.K_RETURN, pygame.K_KP_ENTER):
+            if entry == "Resume":
+                self.close_menu()
+            elif entry == "Restart":
+                self.close_menu()
+                self.restart()
+            elif entry == "Volume":
+                self.flash("sound off" if self.sound.toggle_mute() else "sound on", GOOD)
+            elif entry == "Controls":
+                self.controls = True
+            else:
+                self.running = False
+
     def _key(self, key: int) -> None:
         if self.state == "questions":
             self._answer(key)
             return
-        if key == pygame.K_ESCAPE:
+        if key == pygame.K_q:
             self.running = False
+        elif self.menu is not None:
+            self._menu_key(key)
+        elif key == pygame.K_ESCAPE:
+            self.open_menu()
         elif key == pygame.K_SPACE:
             self.paused = not self.paused
         elif key in (pygame.K_o, pygame.K_TAB):
@@ -363,6 +421,8 @@ class PlayGame(FrameLoop):
         self.world.player_input = (vx / norm, vy / norm) if norm else (0.0, 0.0)
         mods = pygame.key.get_mods()
         self.world.sprinting = bool(mods & pygame.KMOD_SHIFT)
+        self.world.sneaking = not self.world.sprinting and bool(
+            mods & pygame.KMOD_CTRL or pressed[pygame.K_c])
 
     # ------------------------------------------------------------------ frames
     def focus(self) -> tuple[float, float]:
@@ -379,10 +439,14 @@ class PlayGame(FrameLoop):
             self.state = "playing"
 
     def _step(self) -> None:
+        damage = self.world.health.damage_steps
         self.world.step()
+        if self.world.health.damage_steps > damage and time.monotonic() >= self._message_until - 2.0:
+            self.flash(f"hit! HP {max(0.0, self.world.hp):.1f}", BAD)  # the cue (its sound: SoundBoard)
         events = self.goal.update(self.world.player.pos)
         if "collected" in events:
             self.flash(f"picked up ({self.goal.remaining} left)", GOOD)
+            self.sound.play("pickup")
         if "escaped" in events:
             self.world.stop()
 
@@ -430,7 +494,7 @@ class PlayGame(FrameLoop):
             info.append("REC")
         return DrawOptions(
             show_mesh=self.show_mesh, show_plans=self.show_plans,
-            paused=self.paused,
+            paused=self.paused and self.menu is None,  # the menu says PAUSED itself
             help=self.help_items(), message=message, message_color=self.message_color,
             info=info, panel=self.panel(),
             collectibles=self.goal.collectibles[~self.goal.collected],
@@ -508,7 +572,9 @@ class PlayGame(FrameLoop):
 
 # ------------------------------------------------------------ screens over the map
 def play_panel(game: PlayGame) -> Panel | None:
-    """The screen over the map now (ready, questionnaire, game over), if any."""
+    """The screen over the map now (pause menu, ready, questionnaire, game over), if any."""
+    if game.menu is not None:
+        return menu_panel(game)
     goal = game.goal
     if game.state == "ready":
         if goal.has_goal:
@@ -517,7 +583,7 @@ def play_panel(game: PlayGame) -> Panel | None:
         else:
             task = f"Survive {game.world.total_steps * game.world.dt:g} s without being caught"
         return Panel(f"{game.level.name}: ready", (task, "The clock starts on your first move (WASD / arrows)"),
-                     GOOD, hint="N next level · B previous · Esc quit")
+                     GOOD, hint="N next level · B previous · Esc menu · Q quit")
     if game.state == "questions":
         k = len(game.answers)
         return Panel("Your view (1-5)", [q for _, q in QUESTIONS], WARN, choice=k,
@@ -527,12 +593,24 @@ def play_panel(game: PlayGame) -> Panel | None:
     return None
 
 
+def menu_panel(game: PlayGame) -> Panel:
+    """The pause menu (Esc), or its list of controls."""
+    if game.controls:
+        return Panel("Controls", [f"{keys}: {what}" for keys, what in key_help()], WARN,
+                     hint="Esc / Enter back")
+    volume = "muted" if game.sound.muted else f"{round(100 * game.sound.volume)} %"
+    lines = [f"Volume {volume}  (Left / Right, Enter mute)" if entry == "Volume" else entry
+             for entry in MENU]
+    return Panel("PAUSED", lines, WARN, choice=game.menu,
+                 hint="Up / Down choose · Enter select · Esc resume · Q quit")
+
+
 def over_panel(game: PlayGame) -> Panel:
     """The game-over screen: the outcome and the session's metrics (once they are ready)."""
     titles = {"won": ("ESCAPED", GOOD), "caught": ("CAUGHT", BAD),
               "survived": ("SURVIVED", GOOD), "time up": ("TIME UP", WARN)}
     title, color = titles.get(game.outcome, (game.outcome.upper(), WARN))
-    hint = "Enter restart · N next level · 1-5 other guards · Esc quit"
+    hint = "Enter restart · N next level · 1-5 other guards · Esc menu · Q quit"
     pending = game.world.m.distances_pending()
     if pending:  # a large level: the metrics wait for the worker; the window does not
         return Panel(title, [f"time {game.world.t:.1f} s · the metrics follow in a moment "
