@@ -188,3 +188,52 @@ def test_every_action_and_hit_has_its_sound() -> None:
         game.close()
     for kind in ("denied", "throw", "decoy_on", "pickup", "takedown", "hurt"):
         assert calls[kind] == played[kind] >= 1, (kind, dict(calls), dict(played))
+
+
+def test_a_throw_lands_where_clicked_within_the_range_drawn_while_aiming(
+        monkeypatch: pytest.MonkeyPatch) -> None:
+    """The pointer over the map with a throw ready: the range diamond and the landing cross
+    are drawn; a click in range lands on the clicked point (its node gets the noise), one
+    beyond it on the nearest node within range, where the cross said."""
+    from game.actions import node_containing
+
+    game = PlayGame(PlaySettings("maze", overrides=("stimuli.throw_cooldown=0",)),
+                    lockstep=True, size=(960, 640))
+    world = game.world
+    monkeypatch.setattr(pygame.mouse, "get_focused", lambda: True)
+    try:
+        game.start()
+        game.run(1)
+        cs = world.level.cell_size
+        prow, pcol = (int(v // cs) for v in world.player.pos[::-1])
+        near = [int(n) for n in range(world.graph.n)
+                if 2 <= abs(int(world.graph.positions[n][1] // cs) - prow)
+                + abs(int(world.graph.positions[n][0] // cs) - pcol) <= 3]
+        far = max(range(world.graph.n), key=lambda n: float(np.hypot(
+            *(world.graph.positions[n] - np.array(world.player.pos)))))
+        for node, inside in ((near[0], True), (far, False)):
+            target = world.graph.positions[node] + (0.2 * cs, 0.1 * cs)
+            pixel = tuple(int(round(v)) for v in game.renderer.to_screen(*target))
+            clicked = game.renderer.to_world(*pixel)
+            monkeypatch.setattr(pygame.mouse, "get_pos", lambda pixel=pixel: pixel)
+            game.run(1)
+            aim = game.aim()
+            assert aim is not None
+            diamond, point = aim
+            assert len(diamond) == 4 and point is not None
+            if inside:
+                assert point == pytest.approx(clicked)
+            else:
+                assert point != pytest.approx(clicked)
+                assert point in [tuple(p) for p in world.graph.positions.tolist()]
+            pygame.event.post(pygame.event.Event(pygame.MOUSEBUTTONDOWN, button=1, pos=pixel))
+            game.run(1)
+            assert game.landed is not None and game.landed[:2] == pytest.approx(point)
+            (event,) = [e for e in world.events if e.kind == "throw_landed"][-1:]
+            landed_node = event.node
+            assert (landed_node == node_containing(world, *clicked)) is inside
+            assert game.sound.played["throw"] >= 1
+            while any(e.kind == "throw_landed" for e in world.events):
+                game.run(1)  # the AI tick takes the event
+    finally:
+        game.close()

@@ -22,6 +22,7 @@ from __future__ import annotations
 
 import dataclasses
 import gc
+import math
 import sys
 import time
 from collections.abc import Callable
@@ -32,7 +33,7 @@ from game.front.camera import Camera
 from game.front.effects import NoiseRings, draw_rain
 from game.front.frame_loop import FrameLoop
 from game.front.layers import COMPOSE_STRIPES
-from game.front.palette import BAD, GOOD, WARN
+from game.front.palette import BAD, GOOD, NOISE, TEXT, WARN
 from game.front.play_settings import PlaySettings, SessionSink
 from game.front.render import (
     DrawOptions,
@@ -80,6 +81,11 @@ MAX_CATCH_UP = 0.5
 #: A frame that ran more steps than this skips its drawing (never two in a row).
 SKIP_DRAW_STEPS = 2
 MESSAGE_SECONDS = 2.5
+#: game seconds the landing cross of a throw stays drawn
+LANDED_SECONDS = 1.0
+#: above this many nodes the aim shows the range only (the landing search is one pass
+#: over every node: too slow for every mouse move on a 10^6-cell level)
+AIM_CROSS_MAX_NODES = 50_000
 
 
 
@@ -134,6 +140,10 @@ class PlayGame(FrameLoop):
         #: frames whose drawing was skipped to catch up (real time only), and whether the
         #: last one was
         self.skipped_draws, self._skipped_last = 0, False
+        #: the last throw's landing point and game time (its cross is drawn a moment)
+        self.landed: tuple[float, float, float] | None = None
+        self._aim_key: tuple[int, int, int] | None = None
+        self._aim_point: tuple[float, float] | None = None
         self._load(settings.level, settings.guards)
         _freeze_heap()
 
@@ -274,16 +284,17 @@ class PlayGame(FrameLoop):
         """The help line: every key of :func:`game.front.keys.key_help`, shortly."""
         return [f"{keys} {what.split(' (')[0]}" for keys, what in key_help()]
 
-    def _mechanic(self, method: str, *args: float) -> None:
+    def _mechanic(self, method: str, *args: float) -> bool:
+        """Do a mechanic; its message and sound; returns whether it was done."""
         action, label, sound = MECHANICS[method]
         if self.world.done or self.state != "playing":
-            return
+            return False
         try:
             result = action(self.world, *args)
         except (ValueError, RuntimeError) as error:
             self.flash(f"{label}: {error}", BAD)
             self.sound.play("denied")
-            return
+            return False
         done = bool(result) if isinstance(result, str) else result is None or bool(result)
         if isinstance(result, str):  # a refusal is a str that is false (game.world.Refused)
             self.flash(f"{label}: {result}", GOOD if result else BAD)
@@ -295,6 +306,7 @@ class PlayGame(FrameLoop):
             self.sound.play("denied")
         elif sound:
             self.sound.play(sound)
+        return done
 
     def handle(self, event: pygame.event.Event) -> None:
         """React to one pygame event."""
@@ -304,7 +316,9 @@ class PlayGame(FrameLoop):
             x, y = self.renderer.to_world(*event.pos)
             static = self.builder.static
             if 0 <= x <= static.width and 0 <= y <= static.height:
-                self._mechanic("throw_decoy", x, y)
+                point = landing_point(self.world, x, y)
+                if self._mechanic("throw_decoy", x, y):
+                    self.landed = (*point, self.world.t)
         elif (factor := self.zoom_input(event)) is not None:
             self.zoom(factor)
         elif event.type == pygame.KEYDOWN:
@@ -501,10 +515,50 @@ class PlayGame(FrameLoop):
             effects=self._effects,
         )
 
+    def aim(self) -> tuple[list[tuple[float, float]], tuple[float, float] | None] | None:
+        """While a throw is ready and the pointer is over the map: the throw's range (the
+        diamond of ``stimuli.throw_radius`` cells around the player's cell, world points)
+        and where a click there would land (None on a very large level)."""
+        world = self.world
+        if (self.state != "playing" or self.paused or world.done
+                or world.t < world.next_throw - 1e-9 or not pygame.mouse.get_focused()):
+            return None
+        mx, my = pygame.mouse.get_pos()
+        if not self.renderer.layout.world_rect.collidepoint(mx, my):
+            return None
+        cs = world.level.cell_size
+        reach = (world.action_params.throw_radius + 0.5) * cs
+        px, py = world.player.pos
+        cx, cy = (math.floor(px / cs) + 0.5) * cs, (math.floor(py / cs) + 0.5) * cs
+        diamond = [(cx, cy - reach), (cx + reach, cy), (cx, cy + reach), (cx - reach, cy)]
+        if world.graph.n > AIM_CROSS_MAX_NODES:
+            return diamond, None
+        key = (world.player.node, mx, my)
+        if key != self._aim_key:
+            self._aim_key = key
+            self._aim_point = landing_point(world, *self.renderer.to_world(mx, my))
+        return diamond, self._aim_point
+
     def _effects(self, surface: pygame.Surface, renderer: Renderer) -> None:
         if self.world.raining:
             draw_rain(surface, renderer.layout.world_rect, self.world.t)
         self.rings.draw(surface, renderer.to_screen, renderer.layout.scale, self.world.t)
+        aim = self.aim()
+        if aim is not None:
+            diamond, point = aim
+            (x0, y0), (x1, y1) = renderer.to_screen(0, 0), renderer.to_screen(
+                self.builder.static.width, self.builder.static.height)
+            clip = surface.get_clip()
+            surface.set_clip(clip.clip(pygame.Rect(round(x0), round(y0), round(x1 - x0),
+                                                   round(y1 - y0))))  # the level only
+            corners = [renderer.to_screen(*p) for p in diamond]
+            pygame.draw.polygon(surface, (0, 0, 0), corners, 4)
+            pygame.draw.polygon(surface, NOISE, corners, 2)
+            surface.set_clip(clip)
+            if point is not None:
+                _cross(surface, renderer.to_screen(*point), 7, NOISE)
+        if self.landed is not None and self.world.t - self.landed[2] < LANDED_SECONDS:
+            _cross(surface, renderer.to_screen(self.landed[0], self.landed[1]), 9, TEXT)
 
     def draw(self) -> Scene:
         """Build the scene of the world now and draw it to the window."""
@@ -624,6 +678,27 @@ def over_panel(game: PlayGame) -> Panel:
                  + (f" · stars {int(game.goal.collected.sum())}/{len(game.goal.collected)}"
                     if len(game.goal.collected) else ""))
     return Panel(title, lines, color, hint=hint)
+
+
+def landing_point(world: World, x: float, y: float) -> tuple[float, float]:
+    """Where a decoy thrown at (x, y) is seen to land: the clicked point when it lands in
+    the node there (a walkable point within the throw's range), else the position of the
+    node it lands on (:func:`game.actions.landing_node`: the nearest within range)."""
+    from game.actions import node_containing
+
+    node = world.landing_node(x, y)
+    if node == node_containing(world, x, y):
+        return (float(x), float(y))
+    px, py = world.graph.positions[node]
+    return (float(px), float(py))
+
+
+def _cross(surface: pygame.Surface, center: tuple[float, float], r: float,
+           color: tuple[int, int, int]) -> None:
+    x, y = center
+    for dx, dy in ((r, r), (r, -r)):
+        pygame.draw.line(surface, (0, 0, 0), (x - dx, y - dy), (x + dx, y + dy), 4)
+        pygame.draw.line(surface, color, (x - dx, y - dy), (x + dx, y + dy), 2)
 
 
 def _freeze_heap() -> None:
