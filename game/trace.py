@@ -22,7 +22,7 @@ from typing import IO, TYPE_CHECKING, Any
 from ai.plugin_call import call
 from ai.stimuli import STIMULUS_TYPES
 from navmesh.files import FileRefused, read_regular
-from navmesh.level import LEVELS_DIR, Level
+from navmesh.level import LEVELS_DIR, MISSIONS_DIR, Level
 
 if TYPE_CHECKING:
     from .world import World
@@ -76,7 +76,7 @@ def level_ref(level: Level) -> str:
     if level.path is None:
         return level.name
     path = level.path.resolve()
-    if path.parent == LEVELS_DIR.resolve():
+    if path.parent in (LEVELS_DIR.resolve(), MISSIONS_DIR.resolve()):
         return path.stem
     return str(path)
 

@@ -43,7 +43,6 @@ from game.front.render import (
     pygame,
 )
 from game.front.keys import key_help, mode_on_key
-from navmesh.level import bundled_level_names
 from game.front.screens import Panel
 from game.front.sound import SoundBoard
 from game.front.work_ahead import WorkAhead
@@ -220,7 +219,9 @@ class PlayGame(FrameLoop):
 
     def next_level(self, step: int = 1) -> None:
         """Load the next (``step=-1``: previous) level of the playlist, same guards and seed."""
-        names = list(self.settings.playlist) or bundled_level_names()
+        from game.front.chooser import play_levels
+
+        names = list(self.settings.playlist) or play_levels()
         current = self.settings.level
         k = names.index(current) if current in names else -1
         self._close_session("left")
@@ -456,7 +457,8 @@ class PlayGame(FrameLoop):
         damage = self.world.health.damage_steps
         self.world.step()
         if self.world.health.damage_steps > damage and time.monotonic() >= self._message_until - 2.0:
-            self.flash(f"hit! HP {max(0.0, self.world.hp):.1f}", BAD)  # the cue (its sound: SoundBoard)
+            hp = math.floor(max(0.0, self.world.hp) * 10) / 10  # as the HUD will show it
+            self.flash(f"hit! HP {hp:.1f}", BAD)  # the cue (its sound: SoundBoard)
         events = self.goal.update(self.world.player.pos)
         if "collected" in events:
             self.flash(f"picked up ({self.goal.remaining} left)", GOOD)
