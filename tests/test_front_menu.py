@@ -237,3 +237,22 @@ def test_a_throw_lands_where_clicked_within_the_range_drawn_while_aiming(
                 game.run(1)  # the AI tick takes the event
     finally:
         game.close()
+
+
+def test_the_questionnaire_shows_the_result_and_each_answer() -> None:
+    game = PlayGame(PlaySettings("tlou", guards="cheat", record=True, questions=True,
+                                 overrides=("world.player_hp=0.3",)),
+                    lockstep=True, size=(960, 640), on_session=lambda row, trace: None)
+    try:
+        game.start()
+        while game.state == "playing":
+            game.run(30)
+        assert game.state == "questions"
+        panel = game.panel()
+        assert panel is not None and panel.title == "CAUGHT" and f"{game.world.t:.1f} s" in panel.lines[0]
+        _key(game, pygame.K_4)
+        panel = game.panel()
+        assert panel is not None and panel.lines[1].endswith(": 4") and panel.choice == 2
+        assert game.renderer.panel_box is not None  # drawn, beside the map
+    finally:
+        game.close()

@@ -640,9 +640,12 @@ def play_panel(game: PlayGame) -> Panel | None:
             task = f"Survive {game.world.total_steps * game.world.dt:g} s without being caught"
         return Panel(f"{game.level.name}: ready", (task, "The clock starts on your first move (WASD / arrows)"),
                      GOOD, hint="N next level · B previous · Esc menu · Q quit")
-    if game.state == "questions":
+    if game.state == "questions":  # the result stays in view, each answer beside its question
         k = len(game.answers)
-        return Panel("Your view (1-5)", [q for _, q in QUESTIONS], WARN, choice=k,
+        title, color = _OUTCOME_TITLES.get(game.outcome, (game.outcome.upper(), WARN))
+        lines = [f"at {game.world.t:.1f} s. Your view, 1 to 5:"] + [
+            f"{q}: {game.answers[name]}" if name in game.answers else q for name, q in QUESTIONS]
+        return Panel(title, lines, color, choice=k + 1,
                      hint="press 1-5 for the marked question · Enter skip")
     if game.state == "over":
         return over_panel(game)
@@ -661,11 +664,13 @@ def menu_panel(game: PlayGame) -> Panel:
                  hint="Up / Down choose · Enter select · Esc resume · Q quit")
 
 
+_OUTCOME_TITLES = {"won": ("ESCAPED", GOOD), "caught": ("CAUGHT", BAD),
+                   "survived": ("SURVIVED", GOOD), "time up": ("TIME UP", WARN)}
+
+
 def over_panel(game: PlayGame) -> Panel:
     """The game-over screen: the outcome and the session's metrics (once they are ready)."""
-    titles = {"won": ("ESCAPED", GOOD), "caught": ("CAUGHT", BAD),
-              "survived": ("SURVIVED", GOOD), "time up": ("TIME UP", WARN)}
-    title, color = titles.get(game.outcome, (game.outcome.upper(), WARN))
+    title, color = _OUTCOME_TITLES.get(game.outcome, (game.outcome.upper(), WARN))
     hint = "Enter restart · N next level · 1-5 other guards · Esc menu · Q quit"
     pending = game.world.m.distances_pending()
     if pending:  # a large level: the metrics wait for the worker; the window does not
