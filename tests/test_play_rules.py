@@ -209,7 +209,7 @@ def test_the_real_front_an_unaware_guard_does_no_damage_and_a_take_down_works(
 def test_a_replay_of_a_caught_session_ends_caught_at_its_capture_time(tmp_path: Path) -> None:
     """A recorded game caught between two AI ticks (cheat guards, 0.3 HP): its trace ends
     with the capture's moment, and ``stealth replay`` of it ends CAUGHT there, HP 0 (it
-    stopped at the last whole tick, "END OF TRACE", with HP left)."""
+    stopped at the last whole tick, "END OF TRACE", with HP left), with the game's sounds."""
     os.environ.setdefault("SDL_VIDEODRIVER", "dummy")
     os.environ.setdefault("SDL_AUDIODRIVER", "dummy")
     from game.front.play import PlayGame, PlaySettings
@@ -244,6 +244,12 @@ def test_a_replay_of_a_caught_session_ends_caught_at_its_capture_time(tmp_path: 
     assert viewer.t == pytest.approx(capture, abs=1e-6)
     assert viewer.ending() == ("CAUGHT", "caught")
     assert viewer.playback.state(viewer.t)[4] == pytest.approx(0, abs=1e-6)  # HP 0 at the end
+    played = viewer.sound.played  # with sound: the sighting, the hits, the end
+    assert played["lose"] == 1 and played["win"] == 0
+    assert played["sighting"] >= 1 and played["hurt"] >= 1
+    viewer.run(5)
+    assert played["lose"] == 1  # once
+    viewer.close()
 
 
 def test_a_headless_trace_of_a_capture_ends_caught_in_the_replay(tmp_path: Path) -> None:
