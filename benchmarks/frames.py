@@ -47,7 +47,7 @@ Target (issue): median ≤ 8 ms and p99 ≤ 16.7 ms on the busiest overlay.
 ``--pace SECONDS`` (issue 42): the game in real time (miami, MaxMin autopilot, the wall
 clock's frames) for that many wall seconds with a CPU-burning process pinned to the same
 core as this one: game seconds per wall second (target ≥ 0.98) and how many frames skipped
-their drawing to keep up. ``--first-frame``: per bundled level, the wall seconds from
+their drawing to keep up. ``--first-frame``: per mission and bundled level, the wall seconds from
 starting ``stealth play LEVEL --frames 1`` to its exit (its first frame drawn and saved:
 an upper bound of the time to the first frame; target ≤ 3 s on a quiet machine).
 ``--acceptance`` runs both (20 s of pace).
@@ -283,18 +283,18 @@ def measure_pace(seconds: float) -> tuple[float, int, int]:
 
 
 def measure_first_frames() -> list[tuple[str, float]]:
-    """Wall seconds of ``stealth play LEVEL --frames 1`` per bundled level."""
+    """Wall seconds of ``stealth play LEVEL --frames 1`` per mission and bundled level."""
     import subprocess
     import sys
 
-    from navmesh.level import bundled_level_names
+    from game.front.chooser import play_levels
 
     root = Path(__file__).resolve().parent.parent
     env = {**os.environ, "PYTHONPATH": str(root)}
     out = []
     with tempfile.TemporaryDirectory() as data:
         env["STEALTHFIELD_DATA"] = data
-        for name in bundled_level_names():
+        for name in play_levels():  # the missions and the bundled levels
             start = time.perf_counter()
             subprocess.run([sys.executable, "-m", "headless.cli", "play", name, "--frames", "1"],
                            env=env, check=True, capture_output=True)
