@@ -268,3 +268,20 @@ def test_a_headless_trace_of_a_capture_ends_caught_in_the_replay(tmp_path: Path)
     viewer = ReplayViewer(trace, load_level("tlou"), "grid", lockstep=True)
     assert row["metrics"]["captured"] is True
     assert viewer.ending() == ("CAUGHT", "caught") and trace.lines[-1].outcome == ""
+
+
+@pytest.mark.skipif(bool(_MISSING) and not os.environ.get("CI"), reason="needs Xvfb")
+def test_every_action_and_hit_sounds_in_a_real_window(tmp_path: Path) -> None:
+    """tests/test_front_menu.py's scripted session of every action and hit (the mixer
+    calls counted) run again in an X11 window on Xvfb instead of SDL's dummy video."""
+    from game.front.xvfb import xvfb
+
+    with xvfb() as display:
+        env = {**os.environ, "DISPLAY": display, "PYTHONPATH": str(ROOT),
+               "SDL_VIDEODRIVER": "x11", "SDL_AUDIODRIVER": "dummy",
+               "STEALTHFIELD_DATA": str(tmp_path), "STEALTH_TEST_VIDEO_DRIVER": "x11"}
+        done = subprocess.run(
+            [sys.executable, "-m", "pytest", "-q", "-p", "no:xdist", "-p", "no:cacheprovider",
+             str(ROOT / "tests" / "test_front_menu.py") + "::test_every_action_and_hit_has_its_sound"],
+            env=env, capture_output=True, text=True, timeout=300, cwd=ROOT)
+    assert done.returncode == 0, done.stdout[-2000:] + done.stderr[-2000:]
