@@ -5,7 +5,9 @@ sees_player, node, target, state, active}]``, ``events`` and, when stimuli are a
 ``stimuli [{name, node, ...}]``. The first line also names the trial's level (``level``:
 a bundled name or the file's absolute path, ``level_digest``: the SHA-256 of its file) and
 ``abstraction``, so a replay on another level is refused; the last line is the final state
-(marked ``"final": true`` when the trial ended between two AI ticks). :func:`trace_record` builds a line from a
+(marked ``"final": true`` when the trial ended between two AI ticks; a played session's
+final line also names its ``"outcome"`` and may repeat the last tick's moment, which the
+reader then takes as that moment's line). :func:`trace_record` builds a line from a
 :class:`~game.world.World`, :func:`attach_trace` writes one per AI tick to a file, and
 :func:`load_trace` reads and validates a file (every problem is a one-line
 :class:`TraceError`).
@@ -305,6 +307,9 @@ def load_trace(path: str | Path) -> Trace:
             if len(line.guards) != len(lines[0].guards):
                 raise TraceError(f"{where}: guards: {len(line.guards)} guards, but the first "
                                  f"line has {len(lines[0].guards)}")
+            if line.t == lines[-1].t and record.get("final") is True:
+                lines[-1] = line  # the tick's moment again, as the end (a session's outcome)
+                continue
             if line.t <= lines[-1].t:
                 raise TraceError(f"{where}: t: {line.t:g} does not increase (previous {lines[-1].t:g})")
         lines.append(line)

@@ -285,3 +285,30 @@ def test_every_action_and_hit_sounds_in_a_real_window(tmp_path: Path) -> None:
              str(ROOT / "tests" / "test_front_menu.py") + "::test_every_action_and_hit_has_its_sound"],
             env=env, capture_output=True, text=True, timeout=300, cwd=ROOT)
     assert done.returncode == 0, done.stdout[-2000:] + done.stderr[-2000:]
+
+
+def test_a_session_ended_on_a_tick_keeps_its_outcome_and_loads(tmp_path: Path) -> None:
+    """A game that ends on an AI tick (time up at 2.0 s): the final line repeats that moment
+    with the outcome, and the reader takes it as the last line (t still increasing)."""
+    os.environ.setdefault("SDL_VIDEODRIVER", "dummy")
+    os.environ.setdefault("SDL_AUDIODRIVER", "dummy")
+    from game.front.play import PlayGame, PlaySettings
+    from game.trace import load_trace
+
+    got: list[list[str]] = []
+    game = PlayGame(PlaySettings("maze", record=True, overrides=("world.duration=2",)),
+                    lockstep=True, size=(960, 640), on_session=lambda r, t: got.append(list(t)))
+    try:
+        game.start()
+        while not game.world.done:
+            game.run(30)
+        game.run(1)
+    finally:
+        game.close()
+    (lines,) = got
+    assert json.loads(lines[-1])["t"] == json.loads(lines[-2])["t"] == 2.0
+    path = tmp_path / "s.jsonl"
+    path.write_text("\n".join(lines) + "\n")
+    trace = load_trace(path)
+    assert [line.t for line in trace.lines] == [0.0, 1.0, 2.0]
+    assert trace.lines[-1].outcome == "survived"
