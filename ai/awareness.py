@@ -45,7 +45,7 @@ from .params import Params
 from .stimuli import FieldContext, Noise, Rule
 from .view import Event
 
-GAITS = ("still", "walk", "sprint")
+GAITS = ("still", "walk", "sprint", "sneak")
 #: awareness within this of the threshold counts as crossing it (float sums of dt)
 EPS = 1e-9
 
@@ -66,6 +66,8 @@ class AwarenessParams(Params):
     gait_still: float = 0.5
     gait_walk: float = 1.0
     gait_sprint: float = 2.0
+    #: the slow walk (stealth play's Ctrl / C): half as noticeable as walking
+    gait_sneak: float = 0.5
     #: a perceiving guard at or above this (below the threshold) has a glimpse
     suspicion_level: float = 0.2
     #: the suspicion stimulus: −A · falloff^hops up to max_hops, × decay per second
@@ -78,7 +80,7 @@ class AwarenessParams(Params):
         "threshold": POSITIVE, "rise_rate": POSITIVE, "proximity_gain": NON_NEGATIVE,
         "decay_rate": NON_NEGATIVE, "dark_factor": NON_NEGATIVE,
         "concealment_factor": NON_NEGATIVE, "gait_still": NON_NEGATIVE,
-        "gait_walk": NON_NEGATIVE, "gait_sprint": NON_NEGATIVE,
+        "gait_walk": NON_NEGATIVE, "gait_sprint": NON_NEGATIVE, "gait_sneak": NON_NEGATIVE,
         "suspicion_level": NON_NEGATIVE, "suspicion_amplitude": NON_NEGATIVE,
         "suspicion_falloff": UNIT, "suspicion_max_hops": COUNT,
         "suspicion_decay": UNIT,
@@ -98,7 +100,8 @@ class Awareness:
         """Awareness gained per second of perception (the module's formula)."""
         p = self.params
         depth = 1.0 - min(1.0, distance / reach) if reach > 0 else 0.0
-        gaits = {"still": p.gait_still, "walk": p.gait_walk, "sprint": p.gait_sprint}
+        gaits = {"still": p.gait_still, "walk": p.gait_walk, "sprint": p.gait_sprint,
+                 "sneak": p.gait_sneak}
         return (p.rise_rate * (1.0 + p.proximity_gain * depth)
                 * (p.dark_factor if dark else 1.0)
                 * (p.concealment_factor if concealed else 1.0) * gaits[gait])

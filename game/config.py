@@ -44,6 +44,15 @@ HASH_NEUTRAL_PREFIX = "metrics."
 ENGINE_KEY = "world.engine"
 IDENTITY_NEUTRAL: frozenset[str] = frozenset({ENGINE_KEY})
 
+#: keys added after stores were written whose default is the older behaviour: out of
+#: :meth:`Config.hash` while at their default, so those stores keep their hash and resume
+NEUTRAL_AT_DEFAULT: frozenset[str] = frozenset({"world.attack_needs_awareness",
+                                                "world.attack_memory", "world.sneak_factor",
+                                                "awareness.gait_sneak"})
+
+#: the table of ``stealth play``'s own defaults (:func:`play_defaults`), no section of keys
+PLAY_TABLE = "play"
+
 
 def _flatten(table: Mapping[str, Any], prefix: str = "") -> dict[str, Any]:
     flat: dict[str, Any] = {}
@@ -66,7 +75,7 @@ def _file_tables() -> dict[str, Any]:
 def _defaults(registered: Any) -> dict[str, Any]:
     """The file's values with every parameter section's defaults at its table's place
     (sections the file does not name, a registered mode's, at the end)."""
-    tables = _file_tables()
+    tables = {k: v for k, v in _file_tables().items() if k != PLAY_TABLE}
     values: dict[str, Any] = {}
     for name in [*tables, *(s for s in parameter_sections() if s not in tables)]:
         table = tables.get(name, {})
@@ -79,6 +88,17 @@ def _default_values() -> dict[str, Any]:
     """Every config key's default (read-only: shared), for the guard modes and player
     policies registered now."""
     return _defaults(registered_params())
+
+
+def play_defaults() -> dict[str, Any]:
+    """``stealth play``'s own defaults: the ``[play.X]`` tables of defaults.toml as the
+    ``X.*`` keys they set (checked like any override), applied before the player's ``--set``.
+
+    >>> play_defaults()["world.attack_needs_awareness"], Config.defaults()["world.attack_needs_awareness"]
+    (True, False)
+    """
+    table = _file_tables().get(PLAY_TABLE, {})
+    return {key: check_value(key, value) for key, value in _flatten(table).items()}
 
 
 _WORDS = {"true": True, "1": True, "yes": True, "false": False, "0": False, "no": False}
@@ -165,6 +185,11 @@ class Config:
         return cls(_default_values())
 
     @classmethod
+    def for_play(cls, overrides: Iterable[str] | Mapping[str, Any] = ()) -> Config:
+        """The config of a ``stealth play`` game: :func:`play_defaults`, then ``overrides``."""
+        return cls.load(play_defaults()).with_overrides(overrides)
+
+    @classmethod
     def load(cls, overrides: Iterable[str] | Mapping[str, Any] = ()) -> Config:
         """The defaults with ``overrides`` (``"key=value"`` strings or a mapping) applied."""
         return cls.defaults().with_overrides(overrides)
@@ -196,13 +221,15 @@ class Config:
         """A short stable digest of every value: equal configs, equal hashes, any process.
 
         A ``[metrics]`` key (what is measured, never what happens) at its default is left
-        out, so a store written before the section existed keeps its hash and resumes; an
+        out, so a store written before the section existed keeps its hash and resumes (so is
+        a :data:`NEUTRAL_AT_DEFAULT` key at its default); an
         :data:`IDENTITY_NEUTRAL` key (``world.engine``: how, not what) is left out at any
         value, so the same design has one hash on either engine.
         """
         defaults = _default_values()
         values = {k: v for k, v in self._values.items()
                   if k not in IDENTITY_NEUTRAL
-                  and not (k.startswith(HASH_NEUTRAL_PREFIX) and defaults.get(k) == v)}
+                  and not ((k.startswith(HASH_NEUTRAL_PREFIX) or k in NEUTRAL_AT_DEFAULT)
+                           and defaults.get(k) == v)}
         canonical = json.dumps(values, sort_keys=True, separators=(",", ":"))
         return hashlib.sha256(canonical.encode()).hexdigest()[:16]

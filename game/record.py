@@ -21,7 +21,7 @@ from datetime import datetime, timezone
 from typing import Any
 
 from .config import Config
-from .trace import attach_trace
+from .trace import TraceWriter, attach_trace
 from .trial import TrialSpec, identity_row, make_world
 from .world import World
 
@@ -75,10 +75,11 @@ class Recording:
         "%Y%m%dT%H%M%S%fZ"))
     trace: io.StringIO = field(default_factory=io.StringIO)
     _clock: float = field(default_factory=time.perf_counter)
+    _writer: TraceWriter | None = None
 
     def attach(self, world: World) -> None:
         """Trace ``world`` from now on (its t = 0 line at once)."""
-        attach_trace(world, self.trace)
+        self._writer = attach_trace(world, self.trace)
 
     @property
     def key(self) -> str:
@@ -87,7 +88,13 @@ class Recording:
 
     def finish(self, world: World, outcome: Mapping[str, Any],
                ratings: Mapping[str, int] | None = None) -> dict[str, Any]:
-        """The session's row: metrics, heatmaps, ``outcome`` (won, collected) and ``ratings``."""
+        """The session's row: metrics, heatmaps, ``outcome`` (won, collected) and ``ratings``.
+
+        The trace gets its final line (the moment the game ended, between two AI ticks as a
+        capture usually is, with the outcome), so a replay runs to the true end."""
+        if self._writer is not None:
+            self._writer.finish(world, str(outcome.get("outcome", "")))
+            self._writer = None
         extra = {**outcome, **dict(ratings or {})}
         return trial_row(world, self.spec, self.config, key=self.key, extra=extra,
                          wall_time=time.perf_counter() - self._clock)

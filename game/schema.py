@@ -98,12 +98,16 @@ WORLD: Mapping[str, Bound] = {
     "guard_speed": PlayerParams.bounds["guard_speed"],
     "player_speed": PlayerParams.bounds["player_speed"],
     "sprint_factor": POSITIVE,
+    "sneak_factor": POSITIVE,
     # and below half the level's cell size: check_level
     "agent_radius": POSITIVE,
     "view_range": NON_NEGATIVE,
     "fov_deg": Range(0.0, 360.0),
     "attack_range": NON_NEGATIVE,
     "attack_needs_line_of_sight": FLAG,
+    # the game's rule (stealth play's [play.world]); off: the paper's l. 206
+    "attack_needs_awareness": FLAG,
+    "attack_memory": NON_NEGATIVE,
     "stuck_timeout": POSITIVE,
     "engine": OneOf(ENGINES),
 }

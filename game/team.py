@@ -79,6 +79,9 @@ class TeamWorld(Protocol):
     def sprinting(self) -> bool: ...
 
     @property
+    def sneaking(self) -> bool: ...
+
+    @property
     def guard_speed(self) -> float: ...
 
     def view_reach(self) -> float: ...
@@ -126,7 +129,8 @@ class TeamRules:
         reach = world.view_reach()
         dark = bool(world.zones["dark"][node]) if "dark" in world.zones else False
         concealed = bool(world.zones["concealment"][node]) if "concealment" in world.zones else False
-        gait = "still" if not world.player_moved else "sprint" if world.sprinting else "walk"
+        gait = ("still" if not world.player_moved else "sprint" if world.sprinting
+                else "sneak" if world.sneaking else "walk")
         dt = world.dt if world.step_index > 0 else 0.0
         return self.awareness.update(perceived, distances, reach, dark, concealed, gait, node, dt)
 

@@ -5,7 +5,9 @@ sees_player, node, target, state, active}]``, ``events`` and, when stimuli are a
 ``stimuli [{name, node, ...}]``. The first line also names the trial's level (``level``:
 a bundled name or the file's absolute path, ``level_digest``: the SHA-256 of its file) and
 ``abstraction``, so a replay on another level is refused; the last line is the final state
-(marked ``"final": true`` when the trial ended between two AI ticks). :func:`trace_record` builds a line from a
+(marked ``"final": true`` when the trial ended between two AI ticks; a played session's
+final line also names its ``"outcome"`` and may repeat the last tick's moment, which the
+reader then takes as that moment's line). :func:`trace_record` builds a line from a
 :class:`~game.world.World`, :func:`attach_trace` writes one per AI tick to a file, and
 :func:`load_trace` reads and validates a file (every problem is a one-line
 :class:`TraceError`).
@@ -22,7 +24,7 @@ from typing import IO, TYPE_CHECKING, Any
 from ai.plugin_call import call
 from ai.stimuli import STIMULUS_TYPES
 from navmesh.files import FileRefused, read_regular
-from navmesh.level import LEVELS_DIR, Level
+from navmesh.level import LEVELS_DIR, MISSIONS_DIR, Level
 
 if TYPE_CHECKING:
     from .world import World
@@ -76,7 +78,7 @@ def level_ref(level: Level) -> str:
     if level.path is None:
         return level.name
     path = level.path.resolve()
-    if path.parent == LEVELS_DIR.resolve():
+    if path.parent in (LEVELS_DIR.resolve(), MISSIONS_DIR.resolve()):
         return path.stem
     return str(path)
 
@@ -102,10 +104,12 @@ class TraceWriter:
         self.handle.write(json.dumps(record) + "\n")
         self.last_t = record["t"]
 
-    def finish(self, world: World) -> None:
-        """Write the final state, unless the last AI tick already wrote this moment."""
-        if self.last_t is None or _round(world.t) != self.last_t:
-            self.write(world, {"final": True})
+    def finish(self, world: World, outcome: str = "") -> None:
+        """Write the final state, unless the last AI tick already wrote this moment;
+        ``outcome`` (a played session's: ``"caught"``, ``"won"``, ...) goes on it, in a line
+        of its own when the tick wrote the moment."""
+        if self.last_t is None or _round(world.t) != self.last_t or outcome:
+            self.write(world, {"final": True, **({"outcome": outcome} if outcome else {})})
 
 
 def attach_trace(world: World, handle: IO[str], *, explain: bool = False) -> TraceWriter:
@@ -152,6 +156,8 @@ class TraceLine:
     markers: tuple[int, ...] = ()
     #: the team's alert phase, if traced ("" otherwise)
     phase: str = ""
+    #: how a played session ended (``"caught"``, ``"won"``, ...), on its final line only
+    outcome: str = ""
 
 
 @dataclass(frozen=True)
@@ -259,6 +265,7 @@ def parse_line(record: Any, where: str) -> TraceLine:
         guards=tuple(guards),
         events=events,
         phase=str(record.get("phase") or ""),
+        outcome=str(record["outcome"])[:20] if isinstance(record.get("outcome"), str) else "",
     )
 
 
@@ -300,6 +307,9 @@ def load_trace(path: str | Path) -> Trace:
             if len(line.guards) != len(lines[0].guards):
                 raise TraceError(f"{where}: guards: {len(line.guards)} guards, but the first "
                                  f"line has {len(lines[0].guards)}")
+            if line.t == lines[-1].t and record.get("final") is True:
+                lines[-1] = line  # the tick's moment again, as the end (a session's outcome)
+                continue
             if line.t <= lines[-1].t:
                 raise TraceError(f"{where}: t: {line.t:g} does not increase (previous {lines[-1].t:g})")
         lines.append(line)

@@ -76,10 +76,15 @@ class World(PlayerActions):
         self.view_range = float(w["view_range"]) * float(s["view_range_scale"])
         self.attack_range = float(w["attack_range"])
         self.attack_los = bool(w["attack_needs_line_of_sight"])
+        # The game's rule (stealth play): a guard hurts only a player it detects now or did
+        # within attack_memory s; None: the paper's (l. 206), every guard in range hurts.
+        self.attack_memory: float | None = (float(w["attack_memory"])
+                                            if w["attack_needs_awareness"] else None)
         self.radius = float(w["agent_radius"])
         self.hp_max = float(w["player_hp"])
         self.stuck_timeout = float(w["stuck_timeout"])
         self.sprint_factor = float(w["sprint_factor"])
+        self.sneak_factor = float(w["sneak_factor"])
         # Zones (SPEC §5) say what they do to confidence decay and view range (game.zones).
         zone_map = ZoneMap.build(level, self.graph, config)
         self.zone_rules, self.zones, self.view_scale_at = (
@@ -101,6 +106,8 @@ class World(PlayerActions):
         self.sighting: int | None = None
         self.seen_by: tuple[int, ...] = ()
         self.sprinting = False
+        #: the slow walk (stealth play): speed x sneak_factor, the "sneak" gait
+        self.sneaking = False
         self._sprinted = False
         self.player_moved = False
         self.player_input: tuple[float, float] | None = None
@@ -154,6 +161,7 @@ class World(PlayerActions):
         self._watched = self.stimuli.marked_nodes()
 
         self.attackers = 0
+        self._last_seen = [-math.inf] * len(self.guards)  # when each guard last detected
         self._sense()
 
     def start_node(self) -> int:
@@ -259,8 +267,10 @@ class World(PlayerActions):
         return player_speed
 
     def player_step_speed(self) -> float:
-        """The player's speed this step (sprinting or not)."""
-        return self.player_speed * (self.sprint_factor if self.sprinting else 1.0)
+        """The player's speed this step (sprinting, walking slowly or neither)."""
+        if self.sprinting:
+            return self.player_speed * self.sprint_factor
+        return self.player_speed * (self.sneak_factor if self.sneaking else 1.0)
 
     def speeds(self, player_speed: float) -> list[float]:
         """The speed each agent walks at this step: the guards', then the player's."""
@@ -338,10 +348,10 @@ class World(PlayerActions):
         """Vision, attack damage, distance and detection metrics for the current positions."""
         ppos = self.player.pos
         reach = self.view_reach()  # once per step, not once per guard
-        seeing, attackers, nodes, positions = _guard_senses(
+        seeing, in_range, nodes, positions = _guard_senses(
             self.guards, self.senses, ppos, reach, self.attack_range, self.attack_los)
         self.detect(seeing)
-        self.attackers = attackers
+        self.attackers = len(in_range) if self.attack_memory is None else self._aware(in_range)
         if self.step_index > 0:
             self.m.sample_distance(self.graph, self.player.node, nodes)
             self.m.sample_euclidean(ppos, positions)
@@ -354,6 +364,14 @@ class World(PlayerActions):
             self.sighting = self.player.node
             if self.m.first_detect_time is None:
                 self.m.first_detect_time = self.t
+
+    def _aware(self, in_range: Sequence[int]) -> int:
+        """How many of the guards ``in_range`` detect the player now or did within
+        ``world.attack_memory`` s (``world.attack_needs_awareness``)."""
+        for i in self.seen_by:
+            self._last_seen[i] = self.t
+        memory = self.attack_memory or 0.0
+        return sum(1 for i in in_range if self.t - self._last_seen[i] <= memory)
 
     def _captured(self) -> None:
         self.m.count_capture(self.t)
@@ -409,18 +427,21 @@ class World(PlayerActions):
 
 def _guard_senses(guards: list[Agent], senses: Senses, ppos: tuple[float, float], reach: float,
                   attack_range: float, attack_los: bool
-                  ) -> tuple[list[int], int, list[int], list[tuple[float, float]]]:
-    """One pass over the active guards: which see the player (:meth:`World.sees`), how many
+                  ) -> tuple[list[int], list[int], list[int], list[tuple[float, float]]]:
+    """One pass over the active guards: which see the player (:meth:`World.sees`), which
     are in attack range, and their nodes and positions (the distance metrics' samples)."""
     perceives = senses.perceives
-    seeing, attackers, nodes, positions = [], 0, [], []
+    seeing: list[int] = []
+    attackers: list[int] = []
+    nodes: list[int] = []
+    positions: list[tuple[float, float]] = []
     for i, g in enumerate(guards):
         if not g.active:
             continue
         if perceives(g.pos, g.heading, ppos, reach):
             seeing.append(i)
         if perceives(g.pos, None, ppos, attack_range, line_of_sight=attack_los):
-            attackers += 1
+            attackers.append(i)
         nodes.append(g.node)
         positions.append(g.pos)
     return seeing, attackers, nodes, positions

@@ -47,7 +47,9 @@ __all__ = [
     "ZONE_KINDS",
     "Level",
     "LevelError",
+    "MISSIONS_DIR",
     "bundled_level_names",
+    "mission_names",
     "cached_level",
     "load_level",
     "parse_level",
@@ -76,6 +78,10 @@ def _bundled_levels_dir() -> Path:
 LEVELS_DIR = _bundled_levels_dir()
 """Folder of the bundled levels (see :func:`_bundled_levels_dir`)."""
 
+MISSIONS_DIR = LEVELS_DIR.parent / "missions"
+"""Folder of the bundled missions: collect-and-escape levels for ``stealth play`` (stars
+and an exit), named like a bundled level but in no preset or sweep."""
+
 
 # --------------------------------------------------------------------------- loading
 
@@ -85,12 +91,17 @@ def bundled_level_names() -> list[str]:
     return sorted(p.stem for p in LEVELS_DIR.glob("*.json"))
 
 
+def mission_names() -> list[str]:
+    """Names of the missions shipped in ``assets/missions`` (file stems, sorted)."""
+    return sorted(p.stem for p in MISSIONS_DIR.glob("*.json"))
+
+
 def resolve_level_path(path_or_name: str | Path) -> Path:
     """The file a level argument refers to: an existing file, else a bundled level name.
 
     A bare name without a folder or ``.json`` suffix (``"miami"``, case-insensitive) that is
-    not an existing file is looked up in ``assets/levels``; an unknown bare name raises
-    :class:`LevelError` listing the bundled names. Anything else is returned as a path
+    not an existing file is looked up in ``assets/levels``, then ``assets/missions``; an
+    unknown bare name raises :class:`LevelError` listing the bundled names. Anything else is returned as a path
     (whether it exists is :func:`load_level`'s business).
     """
     path = Path(path_or_name)
@@ -98,10 +109,11 @@ def resolve_level_path(path_or_name: str | Path) -> Path:
         return path
     text = str(path_or_name)
     if _looks_like_name(text):
-        bundled = LEVELS_DIR / f"{text.lower()}.json"
-        if bundled.is_file():
-            return bundled
-        names = ", ".join(bundled_level_names()) or "none"
+        for folder in (LEVELS_DIR, MISSIONS_DIR):
+            bundled = folder / f"{text.lower()}.json"
+            if bundled.is_file():
+                return bundled
+        names = ", ".join(bundled_level_names() + mission_names()) or "none"
         raise LevelError(text, "file", f"no such file or bundled level (bundled levels: {names})")
     return path
 

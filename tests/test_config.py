@@ -55,7 +55,8 @@ def test_the_config_hash_is_pinned() -> None:
     assert Config.load(["pf.rho=0.9"]).hash() == "6e28a1d79ad34ffd"
     assert Config.load(["metrics.coverage=seen", "awareness.enabled=true"]).hash() \
         == "53837f3c38328917"
-    assert len(Config.defaults().as_dict()) == 147  # world.engine (SPEC §12)
+    assert len(Config.defaults().as_dict()) == 151  # world.engine (SPEC §12); play: attack_needs_awareness, attack_memory, sneak_factor, gait_sneak
+    assert Config.load(["world.attack_needs_awareness=true"]).hash() != Config.defaults().hash()
     from headless.presets import load_preset
 
     assert load_preset("paper").config_hash == "7647327243295999"

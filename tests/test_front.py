@@ -301,8 +301,8 @@ def test_real_time_mode_steps_by_elapsed_time_and_resizes() -> None:
     try:
         g.frame(3.5 * g.world.dt)
         assert g.world.step_index == 3  # the remaining half step waits for the next frame
-        g.frame(1.0)  # a stalled frame: at most MAX_STEPS_PER_FRAME steps, not 60
-        assert g.world.step_index == 3 + 6
+        g.frame(1.0)  # a stalled frame: at most MAX_CATCH_UP (0.5 s) caught up, not 1 s
+        assert g.world.step_index == 3 + 30
         small = pygame.Surface((640, 480)).convert()
         g.renderer.draw(small, g.builder.from_world(g.world))
         static = g.builder.static

@@ -97,7 +97,9 @@ def test_recording_hands_a_human_row_and_trace_to_the_sink() -> None:
         row, trace = got[0]
         assert row["player"] == "human" and row["key"].startswith("tlou/grid/cheat/human/capture/0/0/")
         assert row["metrics"]["captured"] is True and row["metrics"]["outcome"] == "caught"
-        assert dict(row["overrides"]) == {"world.spawns": "level", "world.player_hp": 0.3}
+        assert dict(row["overrides"]) == {"world.spawns": "level", "world.attack_needs_awareness": True,
+                                          "awareness.enabled": True, "stimuli.takedown_range": 2.0,
+                                          "world.player_hp": 0.3}
         assert len(row["visits"]) == g.world.graph.n and json.loads(trace[0])["t"] == 0.0
     finally:
         g.close()

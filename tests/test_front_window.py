@@ -92,7 +92,7 @@ def test_ready_screen_holds_the_clock_and_an_exit_wins(display: str, tmp_path: P
         time.sleep(2.0)  # on the ready screen: the clock must not run
         _keys(display, window, "d", hold=1.6)  # walk right into the exit: won
         time.sleep(0.5)
-        _keys(display, window, "Escape")
+        _keys(display, window, "q")
         _, err = game.communicate(timeout=60)
     finally:
         game.kill()
@@ -124,7 +124,7 @@ def test_recorded_session_with_questionnaire(display: str, tmp_path: Path) -> No
         time.sleep(5.0)  # caught or out of time within 4 s of game time
         _keys(display, window, "4", "3", "5")
         time.sleep(0.5)
-        _keys(display, window, "Escape")
+        _keys(display, window, "q")
         _, err = game.communicate(timeout=60)
     finally:
         game.kill()

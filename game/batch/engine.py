@@ -55,6 +55,8 @@ def uncovered(spec: TrialSpec, config: Config) -> str | None:
             return f"the team switch [{section}] enabled"
     if config["stimuli.raining"]:
         return "rain (stimuli.raining)"
+    if config["world.attack_needs_awareness"]:  # stealth play's rule: its kernel counts range
+        return "guards that hurt only a player they noticed (world.attack_needs_awareness)"
     if int(config["world.guards"]) > MAX_GUARDS:
         return f"more than {MAX_GUARDS} guards"
     nodes = graph_for(cached_level(spec.level), spec.abstraction,

@@ -7,7 +7,9 @@ renamed, so a crash never leaves half a file. A file that is not the game's — 
 deep or too large, or JSON of another shape — is set aside as ``best.json.corrupt`` (one
 warning line; nothing is lost) and play goes on from no best results; one that cannot be
 read at all (no permission, a directory, a FIFO) is left as it is, never overwritten, and
-nothing is kept that session. Either way the chooser shows no best results.
+nothing is kept that session. Any JSON value may stand anywhere in the file (an object or a
+list where a number or a word belongs, at any depth): the shape check compares types before
+values, so nothing it reads can raise. Either way the chooser shows no best results.
 
 >>> better({"outcome": "won", "time": 40.0}, {"outcome": "caught", "time": 59.0})
 True
@@ -87,9 +89,9 @@ def _shape_problem(loaded: Any) -> str | None:
             where = f"{level!r:.30}/{mode!r:.30}"
             if not isinstance(result, dict):
                 return f"{where} is {_json_kind(result)}, not a result"
-            time, stars = result.get("time"), result.get("stars", 0)
-            if result.get("outcome") not in _RANK:
-                shown = repr(result.get("outcome"))[:30]
+            outcome, time, stars = result.get("outcome"), result.get("time"), result.get("stars", 0)
+            if not isinstance(outcome, str) or outcome not in _RANK:  # an object or list is unhashable
+                shown = repr(outcome)[:30]
                 return f"{where}: outcome {shown} is not one of {', '.join(_RANK)}"
             if isinstance(time, bool) or not isinstance(time, (int, float)) or not 0 <= time <= _MAX_TIME:
                 shown = repr(time) if len(repr(time)) <= 30 else repr(time)[:12] + "…"

@@ -15,6 +15,8 @@ import pygame
 
 from ai import DEFAULT_GUARD_MODE
 
+from navmesh.level import bundled_level_names, mission_names
+
 from .best import BestResults, describe
 from .keys import mode_order
 from .palette import BACKGROUND, BLOCKED, EXIT_EDGE, FLOOR, GOOD, GUARD, TEXT, TEXT_DIM, WARN, WALL
@@ -61,6 +63,12 @@ def thumbnail(level: object, size: tuple[int, int] = THUMB) -> pygame.Surface:
         pygame.draw.circle(surface, GUARD, (gx * scale + ox, gy * scale + oy), 3)
     return surface
 
+
+
+def play_levels() -> list[str]:
+    """What the chooser lists and N / B cycle through: the collect-and-escape missions
+    (``assets/missions``) first, then the bundled levels."""
+    return mission_names() + bundled_level_names()
 
 class LevelCard:
     """What the chooser shows of one level (read once)."""

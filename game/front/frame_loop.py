@@ -33,6 +33,9 @@ class FrameLoop:
     screen: pygame.Surface
     renderer: Renderer
     camera: Camera
+    #: the wall time the last frame of :meth:`run` measured and no frame has used yet: the
+    #: next ``run`` starts with it, so a loop of ``run(N)`` calls loses no time between them
+    _carried: float = 0.0
 
     def focus(self) -> tuple[float, float]:
         """The world point a zoomed camera follows (the player)."""
@@ -86,7 +89,7 @@ class FrameLoop:
         wall time also counts waiting for a core; the benchmark reports both)."""
         times: list[float] = []
         self.cpu_times: list[float] = []
-        elapsed = 0.0
+        elapsed = 0.0 if self.lockstep else self._carried
         while self.running and (frames is None or len(times) < frames):
             start, cpu = time.perf_counter(), time.process_time()
             self.frame(elapsed)
@@ -104,4 +107,5 @@ class FrameLoop:
                 elapsed = 0.0
             else:
                 elapsed = self.clock.tick(60) / 1000.0
+        self._carried = elapsed
         return times

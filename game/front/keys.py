@@ -43,6 +43,7 @@ _MODES = "1-N"
 _KEYS: tuple[tuple[str, str], ...] = (
     ("W A S D / arrows", "move the player"),
     ("Shift", "sprint (footstep noise)"),
+    ("Ctrl / C", "slow walk (half speed, quieter, half as noticeable)"),
     ("left click", "throw a decoy at the pointer"),
     ("E", "activate the static decoy you stand next to"),
     ("F", "take down the guard in reach (leaves a corpse)"),
@@ -57,7 +58,8 @@ _KEYS: tuple[tuple[str, str], ...] = (
     (_MODES, ""),
     ("Enter", "restart"),
     ("N / B", "next / previous level"),
-    ("Esc", "quit"),
+    ("Esc", "pause menu (resume, restart, volume, controls, quit)"),
+    ("Q", "quit"),
 )
 
 

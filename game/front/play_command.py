@@ -11,7 +11,7 @@ from game.front.play import PlayGame
 from game.front.play_settings import PlaySettings, SessionSink
 from game.front.render import init_pygame, pygame, save_screenshot
 from game.scene import overlay_key
-from navmesh.level import bundled_level_names
+
 
 __all__ = ["cmd_play", "finish", "lockstep_wanted", "open_display"]
 
@@ -66,7 +66,7 @@ def cmd_play(args: argparse.Namespace, on_session: SessionSink | None = None) ->
         raise FrontError(f"--frames: expected a positive number of frames, got {args.frames}")
     from game.config import Config
 
-    config = Config.load({"world.spawns": "level"}).with_overrides(args.set)  # bad --set: one line
+    config = Config.for_play(args.set)  # bad --set: one line
     if loaded is not None:
         from game.schema import check_level
 
@@ -74,10 +74,10 @@ def cmd_play(args: argparse.Namespace, on_session: SessionSink | None = None) ->
     open_display()
     level = args.level
     if level is None:
-        from game.front.chooser import LevelChooser
+        from game.front.chooser import LevelChooser, play_levels
 
         pygame.display.set_caption("Stealthfield")
-        chooser = LevelChooser(pygame.display.set_mode((960, 780)), bundled_level_names(),
+        chooser = LevelChooser(pygame.display.set_mode((960, 780)), play_levels(),
                                mode=args.guards)
         level = chooser.run(args.frames)  # --frames: no choice within N frames ends play
         if level is None:

@@ -83,11 +83,20 @@ class Layout:
     help_height: int
     scale: float
     origin: tuple[float, float]
+    #: width of the column kept free right of the map for a screen (ready, menu, ...)
+    side: int = 0
 
     @property
     def world_rect(self) -> pygame.Rect:
         """Screen rectangle of the world extent."""
-        return pygame.Rect(0, self.hud_height, self.size[0], self.size[1] - self.hud_height - self.help_height)
+        return pygame.Rect(0, self.hud_height, self.size[0] - self.side,
+                           self.size[1] - self.hud_height - self.help_height)
+
+    @property
+    def side_rect(self) -> pygame.Rect:
+        """The column beside the map where a screen goes (empty without one)."""
+        area = self.world_rect
+        return pygame.Rect(area.right, area.top, self.side, area.height)
 
 
 def init_pygame() -> None:
@@ -110,6 +119,10 @@ class Renderer:
     HUD_HEIGHT = 50
     HELP_LINE = 18
     MARGIN = 8
+    #: a screen (ready, pause menu, game over, questionnaire) goes in a column this wide
+    #: right of the map in a window at least SIDE_FROM px wide, never over the map
+    SIDE_COLUMN = 300
+    SIDE_FROM = 960
 
     def __init__(self, static: StaticScene, size: tuple[int, int],
                  camera: Camera | None = None, compose_stripes: int = 1) -> None:
@@ -122,6 +135,11 @@ class Renderer:
         self._help_lines: list[str] = []
         self._legend_bar: tuple[tuple[int, float, float], pygame.Surface] | None = None
         self._help_count = 2
+        self._side = 0
+        #: where the HUD's texts went in the last frame (its row, legend, message)
+        self.hud_boxes: list[pygame.Rect] = []
+        #: the box the last screen (panel) was drawn in, if any
+        self.panel_box: pygame.Rect | None = None
         self.layers = StaticLayers(static, compose_stripes)
         self.minimap = Minimap(static)
         self.camera = camera or Camera()
@@ -139,7 +157,7 @@ class Renderer:
     def fit_scale(self, size: tuple[int, int] | None = None) -> float:
         """The px per world unit that shows the whole level in the window."""
         w, h, hud, helph = self._area(size or self._size, self._help_count)
-        avail_w = w - 2 * self.MARGIN
+        avail_w = w - self._side - 2 * self.MARGIN
         avail_h = h - hud - helph - 2 * self.MARGIN
         return max(1e-3, min(avail_w / self.static.width, avail_h / self.static.height))
 
@@ -148,17 +166,18 @@ class Renderer:
         fit = self.fit_scale(size)
         s = self.camera.scale(fit)
         avail_h = h - hud - helph - 2 * self.MARGIN
+        mw = w - self._side  # the map's width
         if self.camera.zoom is None:
-            ox = (w - s * self.static.width) / 2
+            ox = (mw - s * self.static.width) / 2
             oy = hud + self.MARGIN + (avail_h - s * self.static.height) / 2
         else:
-            view_w, view_h = w / s, (h - hud - helph) / s
+            view_w, view_h = mw / s, (h - hud - helph) / s
             cx, cy = self.camera.center
             cx = _clamp(cx, view_w / 2, self.static.width - view_w / 2)
             cy = _clamp(cy, view_h / 2, self.static.height - view_h / 2)
-            ox = w / 2 - cx * s
+            ox = mw / 2 - cx * s
             oy = hud + (h - hud - helph) / 2 - cy * s
-        return Layout((w, h), hud, helph, s, (round(ox), round(oy)))
+        return Layout((w, h), hud, helph, s, (round(ox), round(oy)), self._side)
 
     def resize(self, size: tuple[int, int]) -> None:
         """Adopt a new window size (recomputes the transform; the cache follows)."""
@@ -204,6 +223,11 @@ class Renderer:
         options = options or DrawOptions()
         if surface.get_size() != self.layout.size:
             self.resize(surface.get_size())
+        side = (self.SIDE_COLUMN if options.panel is not None
+                and surface.get_width() >= self.SIDE_FROM else 0)
+        if side != self._side:  # a screen came or went: the map makes room beside it
+            self._side = side
+            self.layout = self._layout(self._size, self._help_count)
         self._wrap_help(options.help)
         area = self.layout.world_rect
         static, region = self.layers.surface(self.visible(), self.layout.scale, scene.layer,
@@ -238,21 +262,30 @@ class Renderer:
         if options.show_plans:
             for i, guard in enumerate(scene.guards):
                 self._draw_target(surface, guard, PLAN_COLORS[i % len(PLAN_COLORS)])
-        self._draw_player(surface, scene)
         self._draw_labels(surface, scene)
+        self._draw_player(surface, scene)  # last: never lost under guards, cones or labels
         if self.zoomed:
             self.minimap.draw(surface, area.bottomright, scene, self.visible())
         surface.set_clip(None)
         self._draw_hud(surface, scene, options)
         self._draw_help(surface)
         player = self.to_screen(*scene.player.pos)
-        if options.panel is not None:
-            draw_panel(surface, area, options.panel, avoid=player)
+        self.panel_box = None
+        if options.panel is not None and self._side:
+            column = self.layout.side_rect
+            surface.fill(BACKGROUND, column)
+            self.panel_box = draw_panel(surface, column, options.panel, column=True)
+        elif options.panel is not None:
+            self.panel_box = draw_panel(surface, area, options.panel, avoid=player)
         elif options.banner:
             draw_panel(surface, area, Panel(options.banner, (options.banner_sub,)), avoid=player)
         if options.paused:  # over any screen: a paused ready screen must not look frozen
             where = "corner" if options.panel is None else "bottom-left"
-            draw_panel(surface, area, Panel("PAUSED", ("Space to continue",), BAD, where=where))
+            if self._side:  # below the screen, in its column
+                draw_panel(surface, self.layout.side_rect, Panel(
+                    "PAUSED", ("Space to continue",), BAD, where="bottom-left"), column=True)
+            else:
+                draw_panel(surface, area, Panel("PAUSED", ("Space to continue",), BAD, where=where))
 
     def _draw_plan(self, surface: pygame.Surface, guard: GuardDrawing, color: Color) -> None:
         if not guard.active:
@@ -333,6 +366,9 @@ class Renderer:
         radius = max(5.0, scene.agent_radius * s)
         color = PLAYER_SPRINT if p.sprinting else PLAYER
         draw_player_halo(surface, center, radius)
+        # a double outline (dark, then light) stands out on floor, cones, guards and markers
+        pygame.draw.circle(surface, (0, 0, 0), center, radius + 5, 2)
+        pygame.draw.circle(surface, (255, 255, 255), center, radius + 3, 2)
         if p.concealed:
             pygame.draw.circle(surface, color, center, radius, 2)
         else:
@@ -413,21 +449,30 @@ class Renderer:
         if p.sprinting:
             items.append(("sprinting", WARN))
         items += [(text, TEXT_DIM) for text in options.info]
-        self._row(surface, bar.right + 10, y, items)
-        if options.message:
-            label = self._text(options.message, self.font, options.message_color)
-            surface.blit(label, (w - label.get_width() - 10, y))
+        end = self._row(surface, bar.right + 10, y, items)
+        self.hud_boxes = [pygame.Rect(10, y, end - 18 - 10, 20)]
+        legend_end = 10
         if options.legend:
-            self._draw_legend(surface, scene, 10, y + 22)
+            legend_end = self._draw_legend(surface, scene, 10, y + 22)
+            self.hud_boxes.append(pygame.Rect(10, y + 22, legend_end - 10, 20))
+        if options.message:
+            # right of the first row; on the second when the row reaches it (a narrow window)
+            label = self._text(options.message, self.font, options.message_color)
+            mx = w - label.get_width() - 10
+            my = y if mx >= end else y + 22
+            if my != y and mx < legend_end + 8:  # both rows full: shorten it
+                mx = legend_end + 8
+                label = label.subsurface((0, 0, max(1, w - 10 - mx), label.get_height()))
+            surface.blit(label, (mx, my))
+            self.hud_boxes.append(pygame.Rect(mx, my, label.get_width(), label.get_height()))
 
-    def _draw_legend(self, surface: pygame.Surface, scene: Scene, x: int, y: int) -> None:
+    def _draw_legend(self, surface: pygame.Surface, scene: Scene, x: int, y: int) -> int:
+        """The overlay's legend from ``x``; returns where it ends."""
         layer = scene.layer
         if scene.overlay == "none":
-            self._row(surface, x, y, [("overlay: none", TEXT_DIM)])
-            return
+            return self._row(surface, x, y, [("overlay: none", TEXT_DIM)]) - 18
         if layer is None:
-            self._row(surface, x, y, [(f"overlay {scene.overlay}: {scene.field_note}", WARN)])
-            return
+            return self._row(surface, x, y, [(f"overlay {scene.overlay}: {scene.field_note}", WARN)]) - 18
         x = self._row(surface, x, y, [(layer.label, TEXT)]) - 8
         lo = self._text(f"{layer.vmin:.3g}", self.font, TEXT)
         surface.blit(lo, (x, y))
@@ -442,7 +487,7 @@ class Renderer:
         hi = self._text(f"{layer.vmax:.3g}", self.font, TEXT)
         surface.blit(hi, (x, y))
         x += hi.get_width() + 18
-        self._row(surface, x, y, [("warm attracts guards · cold repels", TEXT_DIM)])
+        return self._row(surface, x, y, [("warm attracts guards · cold repels", TEXT_DIM)]) - 18
 
     def _bar(self, width: int, vmin: float, vmax: float) -> pygame.Surface:
         """A colour bar from vmin to vmax (on the symmetric scale of the map), cached."""

@@ -219,6 +219,13 @@ class ReplayViewer(FrameLoop):
         self.renderer = Renderer(self.builder.static, self.screen.get_size(), self.camera)
         self.clock = pygame.time.Clock()
         self._player = self.playback.state(self.t)[2]
+        from game.front.sound import SoundBoard
+
+        #: the game's sounds for what the trace's lines say happened (played once per line
+        #: reached moving forward; the end's sound once at the end)
+        self.sound = SoundBoard()
+        self._heard = self.playback.index(self.t + 1e-9)
+        self._end_heard = False
 
     # ------------------------------------------------------------------ input
     HELP = ("Space pause", "Right/Left step one tick", "Up/Down speed", "wheel/+ - zoom",
@@ -298,8 +305,51 @@ class ReplayViewer(FrameLoop):
             phase=line.phase,
         )
 
+    def ending(self) -> tuple[str, str]:
+        """The banner at the trace's end and its kind: a played session's outcome (its final
+        line says), a capture (HP 0 on the last line), else ``"END OF TRACE"``."""
+        last = self.playback.lines[-1]
+        titles = {"caught": "CAUGHT", "won": "ESCAPED", "survived": "SURVIVED",
+                  "time up": "TIME UP"}
+        if last.outcome:
+            return titles.get(last.outcome, last.outcome.upper()), last.outcome
+        if last.hp <= 0:
+            return "CAUGHT", "caught"
+        return "END OF TRACE", ""
+
+    def _hear(self) -> None:
+        """The sounds of the lines reached since the last frame (moving forward), and of
+        the end: a line's events (a decoy's landing, a take-down, a switched-on decoy,
+        sprint footsteps), a sighting that begins, HP lost; win or lose at the end."""
+        i = self.playback.index(self.t + 1e-9)
+        lines = self.playback.lines
+        if i > self._heard:
+            kinds = {"throw_landed": "decoy_landed", "guard_down": "takedown",
+                     "decoy_activated": "decoy_on", "sprint": "step_sprint"}
+            for k in range(self._heard + 1, i + 1):
+                line, before = lines[k], lines[k - 1]
+                for event in dict.fromkeys(line.events):
+                    if event in kinds:
+                        self.sound.play(kinds[event])
+                seen = any(g.sees_player for g in line.guards)
+                if seen and not any(g.sees_player for g in before.guards):
+                    self.sound.play("sighting")
+                if line.hp < before.hp - 1e-9:
+                    self.sound.play("hurt")
+        self._heard = i
+        ended = self.t >= self.playback.end
+        if ended and not self._end_heard:
+            kind = self.ending()[1]
+            if kind in ("caught", "won", "survived", "time up"):
+                self.sound.game_over(kind)
+        self._end_heard = ended
+
+    def close(self) -> None:
+        """Stop the sounds (the window closes)."""
+        self.sound.close()
+
     def frame(self, elapsed: float) -> None:
-        """One frame: events, playback clock, drawing, flip."""
+        """One frame: events, playback clock, sounds, drawing, flip."""
         for event in pygame.event.get():
             self.handle(event)
         if not self.running:
@@ -307,15 +357,18 @@ class ReplayViewer(FrameLoop):
         if not self.paused:
             step = (1 / 60 if self.lockstep else elapsed) * self.speed
             self.t = min(self.t + step, self.playback.end)
+        self._hear()
         scene = self.scene()
         ended = self.t >= self.playback.end
+        banner, color = self.ending()
         info = [f"speed ×{self.speed:g}", f"tick {self.playback.index(self.t + 1e-9) + 1}/{len(self.playback.times)}"]
         if scene.events:
             info.append("events: " + ", ".join(scene.events))
         options = DrawOptions(
             show_mesh=self.show_mesh, show_plans=self.show_plans, paused=self.paused and not ended,
             help=self.HELP, info=info, legend=False,
-            banner="END OF TRACE" if ended else None, banner_sub="Home restart · Left step back · Esc quit",
+            banner=banner if ended else None,
+            banner_sub=f"at {self.playback.end:.1f} s · Home restart · Left step back · Esc quit",
         )
         self.follow()
         self.renderer.draw(self.screen, scene, options)
@@ -378,6 +431,7 @@ def cmd_replay(args: argparse.Namespace, config: Config | None = None) -> int:
         times = viewer.run(args.frames)
         finish(viewer.screen, args.screenshot, times)
     finally:
+        viewer.close()
         pygame.display.quit()
     return 0
 

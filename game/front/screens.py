@@ -54,24 +54,51 @@ def _render(size: int, text: str, color: Color) -> pygame.Surface:
     return label
 
 
+def wrap(text: str, size: int, width: int) -> list[str]:
+    """``text`` in lines of at most ``width`` px in the panel font of ``size`` (word wrap;
+    a single word wider than that stays whole)."""
+    font = _font(size)
+    lines: list[str] = []
+    current = ""
+    for word in text.split(" "):
+        candidate = f"{current} {word}" if current else word
+        if current and font.size(candidate)[0] > width:
+            lines.append(current)
+            current = "   " + word  # a continued line is indented
+        else:
+            current = candidate
+    return lines + [current]
+
+
 def draw_panel(surface: pygame.Surface, area: pygame.Rect, panel: Panel,
-               avoid: tuple[float, float] | None = None) -> pygame.Rect:
+               avoid: tuple[float, float] | None = None, column: bool = False) -> pygame.Rect:
     """Draw ``panel`` inside the map ``area``; returns the box drawn.
 
     A wide panel goes along the top edge, or along the bottom edge when the ``avoid``
-    point (the player on screen) is in the upper half, so it never hides the player."""
+    point (the player on screen) is in the upper half, so it never hides the player.
+    ``column``: ``area`` is the column beside the map; the panel fills its width from the
+    top (``where="bottom-left"``: at its bottom), its lines wrapped to fit."""
     big = 46 if panel.where == "top" else 32
+    inner = area.width - 20 - 36
+    if column and _font(big).size(panel.title)[0] > inner:
+        big = 32
     title = _render(big, panel.title, panel.title_color)
     rows = []
     for i, line in enumerate(panel.lines):
         chosen = panel.choice == i
-        rows.append(_render(22, ("> " if chosen else "  ") + line if panel.choice is not None
-                            else line, WARN if chosen else TEXT))
+        text = ("> " if chosen else "  ") + line if panel.choice is not None else line
+        for part in wrap(text, 22, inner) if column else [text]:
+            rows.append(_render(22, part, WARN if chosen else TEXT))
     if panel.hint:
-        rows.append(_render(22, panel.hint, TEXT_DIM))
+        for part in wrap(panel.hint, 22, inner) if column else [panel.hint]:
+            rows.append(_render(22, part, TEXT_DIM))
     width = max([title.get_width()] + [r.get_width() for r in rows]) + 36
     height = title.get_height() + sum(r.get_height() + 3 for r in rows) + 26
-    if panel.where == "corner":
+    if column:
+        width = area.width - 20
+        x = area.left + 10
+        y = area.bottom - height - 10 if panel.where == "bottom-left" else area.top + 10
+    elif panel.where == "corner":
         x, y = area.right - width - 10, area.top + 10
     elif panel.where == "bottom-left":
         x, y = area.left + 10, area.bottom - height - 10

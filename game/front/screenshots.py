@@ -27,7 +27,7 @@ from game.front.play import PlayGame, PlaySettings
 from game.front.render import pygame, save_screenshot
 
 ROOT = Path(__file__).resolve().parents[2]
-HEIST = ROOT / "examples" / "heist.json"
+HEIST = ROOT / "assets" / "missions" / "heist.json"
 SIZE = (960, 800)
 
 
@@ -110,15 +110,14 @@ def _large() -> PlayGame:
 def _chooser() -> pygame.Surface:
     """The chooser with the player's best results on two levels (a fresh data directory)."""
     from game.front.best import BestResults
-    from game.front.chooser import LevelChooser
-    from navmesh.level import bundled_level_names
+    from game.front.chooser import LevelChooser, play_levels
 
     best = BestResults(Path(tempfile.mkdtemp()) / "best.json")
+    best.offer("heist", "pf", {"outcome": "won", "time": 48.2, "stars": 2})
     best.offer("maze", "pf", {"outcome": "survived", "time": 60.0, "stars": 0})
-    best.offer("miami", "pf", {"outcome": "caught", "time": 41.3, "stars": 0})
     screen = pygame.display.set_mode(SIZE)
-    chooser = LevelChooser(screen, bundled_level_names(), best=best)
-    chooser.index = 3
+    chooser = LevelChooser(screen, play_levels(), best=best)
+    chooser.index = 1  # a mission: stars and an exit
     chooser.run(frames=1)
     return screen
 
@@ -134,6 +133,53 @@ def _awareness() -> PlayGame:
                 g.awareness is not None and 0.45 < g.awareness < 0.9 for g in scene.guards):
             break
     return game
+
+
+def _crowd() -> PlayGame:
+    """Cheat guards closing in on tlou: the player drawn last, outlined, among them."""
+    game = _game("tlou", 0, guards="cheat", overrides=("world.player_hp=100",))
+    game.start()
+    world = game.world
+    for _ in range(3000):
+        game.run(1)
+        near = sum(1 for g in world.guards if float(
+            ((g.pos[0] - world.player.pos[0]) ** 2 + (g.pos[1] - world.player.pos[1]) ** 2)
+            ** 0.5) < 1.6)
+        if near >= 2:
+            break
+    return game
+
+
+def _menu() -> PlayGame:
+    """Esc in a game: the pause menu beside the map."""
+    game = _game("miami", 0, autopilot="maxmin")
+    game.run(240)
+    game.open_menu()
+    game.menu = 2  # the volume
+    game.run(1)
+    return game
+
+
+def _aim() -> pygame.Surface:
+    """The pointer over the map with a throw ready: the range diamond and the landing cross
+    (the frame itself: a later redraw would not have the pointer)."""
+    game = _game("miami", 1)
+    game.start()
+    game.run(1)
+    x, y = game.world.player.pos
+    pixel = tuple(int(v) for v in game.renderer.to_screen(x + 2.2, y + 2.6))
+    mouse = pygame.mouse
+    get_pos, get_focused = mouse.get_pos, mouse.get_focused
+    setattr(mouse, "get_pos", lambda: pixel)  # the pointer there, as a player would hold it
+    setattr(mouse, "get_focused", lambda: True)
+    try:
+        game.run(1)
+        shot = game.screen.copy()
+    finally:
+        setattr(mouse, "get_pos", get_pos)
+        setattr(mouse, "get_focused", get_focused)
+        game.close()
+    return shot
 
 
 def _paused() -> PlayGame:
@@ -199,6 +245,9 @@ SHOTS: dict[str, Callable[[], PlayGame | pygame.Surface]] = {
     "play-chooser.png": _chooser,
     "play-miami-awareness.png": _awareness,
     "play-miami-paused.png": _paused,
+    "play-tlou-crowd.png": _crowd,
+    "play-miami-menu.png": _menu,
+    "play-miami-aim.png": _aim,
     "replay-miami.png": _replay,
     "replay-building-camera.png": _replay_large,
 }

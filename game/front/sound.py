@@ -2,9 +2,11 @@
 
 Every sound is a short buffer made once from sine tones, noise and envelopes (no files,
 so no licence to carry). :class:`SoundBoard` turns what happens in a world into sound
-events — footsteps (walk / sprint, louder on sprints: the steps the guards hear), a thrown
-decoy's landing, a take-down, rain (a loop while it rains), a guard's rising suspicion, the
-sting of a sighting, the team's alert phases as a low cue, and the end of a game — and
+events — footsteps (slow walk / walk / sprint, louder on sprints: the steps the guards
+hear), a throw and its landing, a decoy switched on, a take-down, a star picked up, each hit
+the player takes, an action refused, rain (a loop while it rains), a guard's rising
+suspicion, the sting of a sighting, the team's alert phases as a low cue, and the end of a
+game — and
 counts every event it plays (:attr:`SoundBoard.played`), so a test can check them without
 hearing them.
 
@@ -96,6 +98,16 @@ def _chord(rate: int, seconds: float, freqs: tuple[float, ...], gain: float) -> 
 _MAKERS: dict[str, Callable[[int], np.ndarray]] = {
     "step": lambda r: _step(r, 0.35, 1),
     "step_sprint": lambda r: _step(r, 0.8, 2),
+    "step_quiet": lambda r: _step(r, 0.12, 4),
+    "throw": lambda r: 0.35 * _tone(r, 0.18, 300.0, 900.0, 0.02),
+    "decoy_on": lambda r: np.concatenate([0.4 * _tone(r, 0.09, 1000.0, 1000.0, 0.004),
+                                          np.zeros(int(0.05 * r)),
+                                          0.4 * _tone(r, 0.09, 1000.0, 1000.0, 0.004)]),
+    "pickup": lambda r: np.concatenate([0.45 * _tone(r, 0.1, 988.0, 988.0, 0.004),
+                                        0.45 * _tone(r, 0.2, 1319.0, 1319.0, 0.004)]),
+    "hurt": lambda r: 0.7 * _tone(r, 0.2, 180.0, 90.0, 0.002) + 0.2 * _noise(0.2, r, 7)
+    * _envelope(int(0.2 * r), 0.002, r),
+    "denied": lambda r: 0.3 * _tone(r, 0.15, 220.0, 200.0),
     "decoy_landed": _landing,
     "takedown": _takedown,
     "rain": _rain,
@@ -122,6 +134,8 @@ STRIDE = 0.7
 SPRINT_STRIDE = 0.9
 #: awareness (fraction of the detection threshold) at which a guard's suspicion sounds
 SUSPICION_LEVELS = (0.3, 0.6)
+#: game seconds between two ``hurt`` sounds while the player keeps being hit
+HURT_REPEAT = 0.5
 
 
 class SoundBoard:
@@ -150,6 +164,9 @@ class SoundBoard:
         self._detected = False
         self._phase = ""
         self._suspicion: dict[int, int] = {}
+        self._active: int | None = None
+        self._damage = 0
+        self._hurt_at = -HURT_REPEAT
         self._set_rain(False)
 
     # ------------------------------------------------------------------ keys
@@ -192,15 +209,26 @@ class SoundBoard:
         stride = SPRINT_STRIDE if sprinting else STRIDE
         if self._walked >= stride:
             self._walked %= stride
-            self.play("step_sprint" if sprinting else "step")
+            self.play("step_sprint" if sprinting else
+                      "step_quiet" if getattr(world, "sneaking", False) else "step")
         events = getattr(world, "tick_events")
         if events is not self._seen_events:
             self._seen_events = events
             for event in events:
                 if event.kind == "throw_landed":
                     self.play("decoy_landed")
-                elif event.kind == "guard_down":
-                    self.play("takedown")
+        # a take-down the moment a guard goes down (its event waits for the AI tick)
+        active = sum(1 for g in getattr(world, "guards") if g.active)
+        if self._active is not None and active < self._active:
+            self.play("takedown")
+        self._active = active
+        # each hit: the damage grew since the last frame (at most every HURT_REPEAT s)
+        damage = int(getattr(world, "health").damage_steps)
+        t = float(getattr(world, "t"))
+        if damage > self._damage and t - self._hurt_at >= HURT_REPEAT:
+            self.play("hurt")
+            self._hurt_at = t
+        self._damage = damage
         self._set_rain(bool(getattr(world, "raining", False)))
         for i, level in enumerate(awareness):
             reached = sum(level is not None and level >= mark for mark in SUSPICION_LEVELS)

@@ -85,7 +85,7 @@ class SessionStore:
         with ResultStore(self.directory / STORE_NAME) as store:
             store.add(row)
             done = store.done_keys()
-            config = Config.load({"world.spawns": "level"}).with_overrides(self.overrides)
+            config = Config.for_play(self.overrides)
             for player in COMPARE:
                 spec = TrialSpec(
                     level=str(row["level_ref"]), abstraction=str(row["abstraction"]),
