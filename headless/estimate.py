@@ -42,10 +42,11 @@ TRIAL_SECONDS: dict[tuple[str, str, str], float] = {
 }
 """Mean wall time (s) of one trial per (level, abstraction, scenario), measured as above."""
 
-BATCH_COST = 0.6
-"""A trial's time on the batch engine over its time on the pymunk engine: the inverse of
-``python benchmarks/batch.py --seeds 3``'s ratio of trials per CPU second (1.6-1.7 on
-2026-12-07, batches of 60 trials)."""
+BATCH_COST = 0.7
+"""A trial's time on the batch engine over its time on the pymunk engine: ``stealth run
+--preset quick`` with ``--set world.engine=auto`` against ``=pymunk``, 2 workers, quiet
+(46.3 s / 66.4 s on 2026-12-07; ``python benchmarks/batch.py --seeds 3``'s CPU-time ratio
+is 1.71, the sweep's start and smaller batches cost the rest)."""
 
 _MEAN = sum(TRIAL_SECONDS.values()) / len(TRIAL_SECONDS)
 
