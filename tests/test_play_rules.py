@@ -257,6 +257,62 @@ def test_a_replay_of_a_caught_session_ends_caught_at_its_capture_time(tmp_path: 
     viewer.close()
 
 
+_REPLAY = textwrap.dedent("""
+    import json, sys
+    from game.front.play import PlayGame, PlaySettings
+    from game.front.render import pygame
+    from game.front.replay import ReplayViewer
+    from game.trace import load_trace
+    from navmesh.level import load_level
+
+    got = []
+    game = PlayGame(PlaySettings("tlou", guards="cheat", record=True,
+                                 overrides=("world.player_hp=0.3",)),
+                    lockstep=True, size=(960, 800), on_session=lambda r, t: got.append(list(t)))
+    driver = pygame.display.get_driver()
+    game.start()
+    while not game.world.done:
+        game.run(30)
+    game.run(1)
+    capture = game.world.t
+    game.close()
+    with open(sys.argv[1], "w") as handle:
+        handle.write("".join(line + "\\n" for line in got[0]))
+    viewer = ReplayViewer(load_trace(sys.argv[1]), load_level("tlou"), "grid", lockstep=True,
+                          speed=32.0, config=game.config)
+    viewer.run(int(capture * 60 / 32) + 5)
+    out = dict(driver=driver, replay_driver=pygame.display.get_driver(), capture=capture,
+               t=viewer.t, ending=list(viewer.ending()), hp=viewer.playback.state(viewer.t)[4],
+               played=dict(viewer.sound.played))
+    viewer.close()
+    print(json.dumps(out))
+""")
+
+
+@pytest.mark.skipif(bool(_MISSING) and not os.environ.get("CI"), reason="needs Xvfb")
+def test_the_real_front_replays_a_caught_session_to_caught(tmp_path: Path) -> None:
+    """The same caught session played and replayed in an X11 window on Xvfb: the replay
+    ends CAUGHT at the session's capture time (between two AI ticks), HP 0, with the sound
+    of the end."""
+    from game.front.xvfb import xvfb
+
+    (tmp_path / "script.py").write_text(_REPLAY)
+    with xvfb() as display:
+        env = {**os.environ, "DISPLAY": display, "PYTHONPATH": str(ROOT),
+               "SDL_AUDIODRIVER": "dummy", "STEALTHFIELD_DATA": str(tmp_path)}
+        env.pop("SDL_VIDEODRIVER", None)
+        done = subprocess.run([sys.executable, str(tmp_path / "script.py"),
+                               str(tmp_path / "session.jsonl")], env=env, capture_output=True,
+                              text=True, timeout=180)
+    assert done.returncode == 0, done.stderr
+    out = json.loads(done.stdout.splitlines()[-1])
+    assert out["driver"] == out["replay_driver"] == "x11"
+    assert round(out["capture"], 6) % 1.0 != 0  # between two AI ticks
+    assert out["t"] == pytest.approx(out["capture"], abs=1e-6)
+    assert out["ending"] == ["CAUGHT", "caught"] and out["hp"] == pytest.approx(0, abs=1e-6)
+    assert out["played"]["lose"] == 1 and out["played"]["hurt"] >= 1
+
+
 def test_a_headless_trace_of_a_capture_ends_caught_in_the_replay(tmp_path: Path) -> None:
     """``stealth sim --trace`` already wrote the final moment; its replay names it."""
     os.environ.setdefault("SDL_VIDEODRIVER", "dummy")
