@@ -7,7 +7,6 @@ import json
 import os
 import subprocess
 import sys
-from collections import Counter
 from pathlib import Path
 
 import pytest
@@ -21,7 +20,8 @@ from game.front.chooser import LevelChooser, thumbnail
 from game.front.palette import FLOOR
 from game.front.play import PlayGame, PlaySettings
 from game.front.render import pygame
-from game.front.sound import KINDS, SoundBoard
+from game.front.sound import SoundBoard
+from mixer_calls import count_mixer_calls
 
 SIZE = (640, 520)
 
@@ -36,31 +36,11 @@ def _dummy_audio(monkeypatch: pytest.MonkeyPatch):  # type: ignore[no-untyped-de
     pygame.mixer.quit()
 
 
-class _CountingSound:
-    """Stands in for a mixer Sound: counts the mixer calls made for one kind."""
-
-    def __init__(self, kind: str, calls: Counter[str]) -> None:
-        self.kind, self.calls = kind, calls
-
-    def play(self, loops: int = 0) -> None:
-        self.calls[self.kind] += 1
-
-    def set_volume(self, volume: float) -> None:
-        pass
-
-
-def _count_mixer_calls(board: SoundBoard) -> Counter[str]:
-    assert board.available, "the dummy audio driver opens a mixer"
-    calls: Counter[str] = Counter()
-    board._sounds = {kind: _CountingSound(kind, calls) for kind in KINDS}  # type: ignore[misc]
-    return calls
-
-
 def test_a_scripted_session_plays_every_sound_event() -> None:
     game = PlayGame(PlaySettings("miami", autopilot="maxmin", overrides=(
         "awareness.enabled=true", "alert.enabled=true", "world.duration=30")),
         lockstep=True, size=SIZE)
-    calls = _count_mixer_calls(game.sound)
+    calls = count_mixer_calls(game.sound)
     world = game.world
     try:
         game.run(120)  # walking
@@ -88,7 +68,7 @@ def test_a_scripted_session_plays_every_sound_event() -> None:
 def test_mute_stops_the_mixer_calls_but_not_the_count() -> None:
     pygame.display.init()
     board = SoundBoard()
-    calls = _count_mixer_calls(board)
+    calls = count_mixer_calls(board)
     assert board.toggle_mute() is True
     board.play("sighting")
     assert board.played["sighting"] == 1 and calls["sighting"] == 0

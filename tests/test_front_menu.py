@@ -5,7 +5,6 @@ counted per sound kind (a stand-in Sound object), so nothing is heard or timed."
 from __future__ import annotations
 
 import os
-from collections import Counter
 from pathlib import Path
 
 import numpy as np
@@ -17,7 +16,7 @@ os.environ.setdefault("SDL_AUDIODRIVER", "dummy")
 from ai.awareness import Awareness, AwarenessParams  # noqa: E402
 from game.front.play import MENU, PlayGame, PlaySettings  # noqa: E402
 from game.front.render import pygame  # noqa: E402
-from game.front.sound import KINDS, SoundBoard  # noqa: E402
+from mixer_calls import count_mixer_calls  # noqa: E402
 
 ROOT = Path(__file__).resolve().parent.parent
 HEIST = str(ROOT / "examples" / "heist.json")
@@ -30,24 +29,6 @@ def _dummy_audio(monkeypatch: pytest.MonkeyPatch, tmp_path: Path):  # type: igno
     pygame.mixer.quit()
     yield
     pygame.mixer.quit()
-
-
-class _Counting:
-    def __init__(self, kind: str, calls: Counter[str]) -> None:
-        self.kind, self.calls = kind, calls
-
-    def play(self, loops: int = 0) -> None:
-        self.calls[self.kind] += 1
-
-    def set_volume(self, volume: float) -> None:
-        pass
-
-
-def _count(board: SoundBoard) -> Counter[str]:
-    assert board.available
-    calls: Counter[str] = Counter()
-    board._sounds = {kind: _Counting(kind, calls) for kind in KINDS}  # type: ignore[misc]
-    return calls
 
 
 def _key(game: PlayGame, *keys: int) -> None:
@@ -118,7 +99,7 @@ def test_the_slow_walk_is_half_speed_quieter_and_half_as_noticeable(
     for mods in (pygame.KMOD_LCTRL, 0):
         game = PlayGame(PlaySettings(HEIST, guards="random"), lockstep=True, size=(960, 640))
         try:
-            calls = _count(game.sound)
+            calls = count_mixer_calls(game.sound)
             world = game.world
             start = np.array(world.player.pos)
             monkeypatch.setattr(pygame.key, "get_pressed", lambda: _Pressed({pygame.K_d}))
@@ -140,7 +121,7 @@ def test_every_action_and_hit_has_its_sound() -> None:
     take-down, a throw, a decoy switched on, a star picked up, a take-down from behind and
     the hits of a guard that sees the player each call the mixer once per event."""
     game = PlayGame(PlaySettings(HEIST, guards="random"), lockstep=True, size=(960, 640))
-    calls = _count(game.sound)
+    calls = count_mixer_calls(game.sound)
     world = game.world
     played = game.sound.played
 
