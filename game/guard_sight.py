@@ -64,10 +64,10 @@ def _compiled() -> ModuleType:
 
 class _NodeIndex:
     """A graph's nodes by place, as arrays the compiled loops read: the grid's own cells, or
-    a partition's node positions bucketed in square cells of side ``cell`` (CSR lists).
-    Built once per graph and cell side, shared by every trial (graphs are cached)."""
+    a partition's node positions bucketed in square cells (CSR lists) about two node
+    spacings wide. Built once per graph, shared by every trial (graphs are cached)."""
 
-    def __init__(self, graph: NodeGraph, cell: float) -> None:
+    def __init__(self, graph: NodeGraph) -> None:
         self.positions = np.ascontiguousarray(graph.positions, dtype=np.float64)
         if graph.cell_node is not None:
             self.is_grid = True
@@ -83,9 +83,8 @@ class _NodeIndex:
         if not len(pts):
             pts = np.zeros((1, 2))
         lo, hi = pts.min(axis=0), pts.max(axis=0)
-        # at most a few cells per node, however small the view range
-        cell = max(float(cell), math.sqrt(float(np.prod(hi - lo + 1.0)) / (4 * len(pts) + 64)),
-                   1e-3)
+        # about four nodes a cell, whatever the view range (a window spans more cells)
+        cell = max(2.0 * math.sqrt(float(np.prod(hi - lo + 1.0)) / len(pts)), 1e-3)
         ncx, ncy = (int(k) for k in np.floor((hi - lo) / cell) + 1)
         cx = np.floor((self.positions[:, 0] - lo[0]) / cell).astype(np.int64)
         cy = np.floor((self.positions[:, 1] - lo[1]) / cell).astype(np.int64)
@@ -103,16 +102,14 @@ class _NodeIndex:
                 self.items, self.geom)
 
 
-#: per graph (graphs are cached and shared by trials): its node index per cell side
-_INDEXES: weakref.WeakKeyDictionary[NodeGraph, dict[float, _NodeIndex]] = (
-    weakref.WeakKeyDictionary())
+#: per graph (graphs are cached and shared by trials): its node index
+_INDEXES: weakref.WeakKeyDictionary[NodeGraph, _NodeIndex] = weakref.WeakKeyDictionary()
 
 
-def _node_index(graph: NodeGraph, cell: float) -> _NodeIndex:
-    per_cell = _INDEXES.setdefault(graph, {})
-    index = per_cell.get(cell)
+def _node_index(graph: NodeGraph) -> _NodeIndex:
+    index = _INDEXES.get(graph)
     if index is None:
-        index = per_cell[cell] = _NodeIndex(graph, cell)
+        index = _INDEXES[graph] = _NodeIndex(graph)
     return index
 
 
@@ -120,7 +117,7 @@ def nodes_within(graph: NodeGraph, x: float, y: float, radius: float) -> np.ndar
     """Indices of nodes whose position may lie within ``radius`` of (x, y): a superset
     (the grid's square window of cells; a partition's buckets under the disc's box)."""
     buf = np.empty(graph.n, dtype=np.int64)
-    count = _compiled().near(*_node_index(graph, max(radius, 1.0)).arrays, float(x), float(y),
+    count = _compiled().near(*_node_index(graph).arrays, float(x), float(y),
                              float(radius), buf)
     return buf[:count]
 
@@ -165,7 +162,7 @@ class GuardSight(_NodeView):
                  walls: np.ndarray) -> None:
         super().__init__(graph, senses, reach, walls)
         self.bound = float(self.limit.max()) if len(self.limit) else 0.0
-        self.index = _node_index(graph, max(self.bound, 1.0))
+        self.index = _node_index(graph)
 
     def seen(self, guards: Sequence[Agent]) -> tuple[np.ndarray, ...]:
         """Per guard, the sorted node indices it sees now (empty for a guard out of play)."""
@@ -204,7 +201,7 @@ class ViewCover(_NodeView):
                               if isinstance(shape, pymunk.Segment)], dtype=np.float64)
         super().__init__(graph, senses, reach, walls)
         self.bound = float(self.reach.max()) if len(self.reach) else 0.0
-        self.index = _node_index(graph, max(self.bound, 1.0))
+        self.index = _node_index(graph)
         self._seen = np.zeros(graph.n, dtype=bool)
         self._blocker = np.full(graph.n, -1, dtype=np.int64)
         #: per noted AI tick: the active guards' (x, y, cos, sin), not yet worked through
