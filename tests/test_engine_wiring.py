@@ -75,6 +75,16 @@ def test_sim_refuses_an_unknown_engine_in_one_line(capsys: pytest.CaptureFixture
     assert captured.out == ""
 
 
+def test_play_refuses_the_batch_engine_in_one_line_before_a_window_opens(
+        capsys: pytest.CaptureFixture[str]) -> None:
+    assert main(["play", "maze", "--set", "world.engine=batch"]) == 2
+    captured = capsys.readouterr()
+    assert _one_error_line(captured.err) == (
+        'stealth: error: world.engine = "batch" does not cover stealth play (one game in '
+        'real time); leave world.engine at "auto" or set "pymunk"')
+    assert captured.out == ""
+
+
 # ------------------------------------------------------------------ the batch engine's module
 @pytest.fixture
 def batch_module(monkeypatch: pytest.MonkeyPatch) -> types.ModuleType:

@@ -64,9 +64,12 @@ def cmd_play(args: argparse.Namespace, on_session: SessionSink | None = None) ->
         raise FrontError(f"--overlay: {error}") from None
     if args.frames is not None and args.frames < 1:
         raise FrontError(f"--frames: expected a positive number of frames, got {args.frames}")
-    from game.config import Config
+    from game.config import ENGINE_KEY, Config
 
     config = Config.for_play(args.set)  # bad --set: one line
+    if config[ENGINE_KEY] == "batch":  # a game is one trial in real time: the reference's
+        raise FrontError('world.engine = "batch" does not cover stealth play (one game in real '
+                         'time); leave world.engine at "auto" or set "pymunk"')
     if loaded is not None:
         from game.schema import check_level
 
