@@ -27,8 +27,13 @@ class Health:
 
     def hurt(self, guards: int) -> bool:
         """``guards`` guards hurt the player for one step; True when that was lethal."""
+        lethal = self.lethal(guards)
         self.damage_steps += guards
-        return self.damage_steps >= self.lethal_steps
+        return lethal
+
+    def lethal(self, guards: int) -> bool:
+        """Whether ``guards`` guards hurting the player for one step would be lethal."""
+        return self.damage_steps + guards >= self.lethal_steps
 
     def heal(self) -> None:
         """Full HP again (a respawn)."""

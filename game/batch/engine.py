@@ -21,6 +21,7 @@ from typing import Any
 
 import numpy as np
 
+from ai.view import PlayerPolicy
 from navmesh.graph import NodeGraph, graph_for
 from navmesh.level import cached_level
 
@@ -167,6 +168,10 @@ class Batch:
         self.sprinting = np.zeros(n_trials, dtype=np.bool_)
         self.has_policy = np.array([w.player_policy is not None for w in self.worlds],
                                    dtype=np.bool_)
+        # a player policy with actions of its own (take-downs, throws) may change any agent
+        self.acting = np.array([w.player_policy is not None
+                                and type(w.player_policy).actions is not PlayerPolicy.actions
+                                for w in self.worlds], dtype=np.bool_)
         self.step_index = 0
 
     def agents(self, b: int) -> list[Agent]:
@@ -191,6 +196,31 @@ class Batch:
             if agent.velocity != (self.cmd[b, a, 0], self.cmd[b, a, 1]):
                 agent.velocity = (float(self.cmd[b, a, 0]), float(self.cmd[b, a, 1]))
             agent.heading = float(self.heading[b, a])
+
+    def pull_view(self, b: int) -> None:
+        """Write what a :class:`~ai.view.WorldView` and a plan read (clock, positions,
+        headings) into trial ``b``'s world; nothing it would write back."""
+        world = self.worlds[b]
+        world.step_index = self.step_index
+        world.attackers = int(self.attackers[b])
+        heading = self.heading[b].tolist()
+        for agent, (x, y), h in zip(self.agents(b), self.pos[b].tolist(), heading):
+            agent.pos = (x, y)
+            agent.heading = h
+
+    def _decide(self, b: int, askers: list[int]) -> None:
+        """:meth:`World.decide` in trial ``b``, whose agents ``askers`` have no plan: only
+        they change (a policy's actions may change any agent: then all are read back)."""
+        self.pull_view(b)
+        for a in askers:
+            self.pull(b, a)
+        world = self.worlds[b]
+        world.decide()
+        if self.acting[b]:
+            self.push(b)
+            return
+        for a in askers:
+            self.push(b, a)
 
     def push(self, b: int, only: int | None = None) -> None:
         """Read trial ``b``'s world back into the arrays (one agent: ``only``)."""
@@ -232,9 +262,7 @@ class Batch:
             idle[:, :-1] &= self.active[:, :-1]
             idle[:, -1] &= self.has_policy
             for b in np.flatnonzero(live & idle.any(axis=1)).tolist():
-                self.pull(b)
-                self.worlds[b].decide()
-                self.push(b)
+                self._decide(b, np.flatnonzero(idle[b]).tolist())
         kernels.drive(live, self.active, self.has_wp, self.wp, self.pos, self.cruise_ok,
                       self.cruise_speed, self.cruise_rem, self.on_track, self.speed, self.cmd,
                       self.vel, self.heading, dt)
@@ -269,9 +297,10 @@ class Batch:
         self._sense()
         if self.step_index % self.steps_per_tick == 0:
             for b in np.flatnonzero(live).tolist():
-                self.pull(b)
+                # the tick reads where the agents are and changes none of them (the rules
+                # that would: team switches, plugin stimuli, are not covered)
+                self.pull_view(b)
                 self.worlds[b].end_step()
-                self.push(b)
                 self.ended[b] = self.worlds[b].done
         elif self.step_index >= self.total_steps:
             for b in np.flatnonzero(live).tolist():
@@ -305,6 +334,11 @@ class Batch:
         ``pos`` still the step's start); the player's body holds where it moved to, unless
         a respawn places it elsewhere."""
         world = self.worlds[b]
+        attackers = int(self.attackers[b])
+        if not world.health.lethal(attackers):  # damage alone: no agent moves, none is read
+            world.step_index, world.attackers = self.step_index, attackers
+            world.hurt((0.0, 0.0))
+            return
         self.pull(b)
         agents = self.agents(b)
         for a, agent in enumerate(agents):
@@ -390,7 +424,13 @@ def _bits(guards: Sequence[int]) -> int:
 
 
 def _guards(bits: int) -> tuple[int, ...]:
+    if bits < len(_SMALL_MASKS):
+        return _SMALL_MASKS[bits]
     return tuple(g for g in range(bits.bit_length()) if bits >> g & 1)
+
+
+#: the guards of every mask of up to 8 guards, in order (a sighting is looked up, not decoded)
+_SMALL_MASKS = [tuple(g for g in range(8) if bits >> g & 1) for bits in range(256)]
 
 
 __all__ = ["Batch", "MAX_BATCH", "refusal_text", "run_trials", "uncovered"]
