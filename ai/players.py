@@ -7,11 +7,10 @@ cached: MaxMin's move sequences per start node, SafetyGraph's edge list.
 
 from __future__ import annotations
 
-import heapq
-import itertools
 import math
 import weakref
 from collections.abc import Mapping
+from types import ModuleType
 from typing import Any
 
 import numpy as np
@@ -97,6 +96,14 @@ def move_sequences(graph: NodeGraph, depth: int) -> MoveSequences:
     return per_graph[depth]
 
 
+def _search_kernels() -> ModuleType:
+    """The compiled searches (:mod:`ai.search_kernels`), imported at first use: numba costs
+    a second of start-up that a game without a MaxMin or SafetyGraph player need not pay."""
+    from . import search_kernels
+
+    return search_kernels
+
+
 class MaxMinPlayer(PlayerPolicy):
     """Look ``maxmin_depth`` moves ahead; keep the sequence whose closest guard stays farthest.
 
@@ -134,14 +141,9 @@ class MaxMinPlayer(PlayerPolicy):
             return node
         # (n,) distance to the closest guard, promised on the nodes the sequences can reach
         nearest = self.graph.nearest_dist(guards, around=node, reach=self.reach)
-        paths = self.sequences.from_node(node)
-        along = nearest[paths] - self.closing  # (m, depth)
-        score = along.min(axis=1)
-        eps = self.config.tie_eps
-        best = score >= score.max() - eps
-        final = np.where(best, along[:, -1], -np.inf)
-        best &= final >= final.max() - eps
-        first = np.unique(paths[best, 0])
+        # score = min over the sequence of (distance − closing), compiled (ai.search_kernels)
+        first = _search_kernels().maxmin_firsts(nearest, self.sequences.from_node(node),
+                                                self.closing, self.config.tie_eps)
         return int(first[0] if len(first) == 1 else first[self.rng.integers(len(first))])
 
 
@@ -293,32 +295,9 @@ class SafetyGraphPlayer(PlayerPolicy):
         penalty = 1.0 + self.config.safety_penalty * np.maximum(0.0, deficit)
         positions = self.graph.positions
         heuristic = np.linalg.norm(positions - positions[goal], axis=1)
-        indptr, indices, lengths = self._indptr, self._indices, self._lengths
-        cost = {node: 0.0}
-        parent: dict[int, int] = {}
-        counter = itertools.count()
-        open_list = [(float(heuristic[node]), next(counter), node)]
-        closed: set[int] = set()
-        while open_list:
-            _, _, u = heapq.heappop(open_list)
-            if u == goal:
-                path = [u]
-                while path[-1] != node:
-                    path.append(parent[path[-1]])
-                return path[::-1]
-            if u in closed:
-                continue
-            closed.add(u)
-            base = cost[u]
-            for e in range(indptr[u], indptr[u + 1]):
-                v = int(indices[e])
-                if v in closed:
-                    continue
-                g = base + float(lengths[e] * penalty[v])
-                if g < cost.get(v, math.inf):
-                    cost[v], parent[v] = g, u
-                    heapq.heappush(open_list, (g + float(heuristic[v]), next(counter), v))
-        return [node]  # the goal is unreachable (paper_goal only picks reachable nodes)
+        path: list[int] = _search_kernels().astar(node, goal, self._indptr, self._indices,
+                                                  self._lengths, penalty, heuristic).tolist()
+        return path
 
     def _step_along(self, path: list[int]) -> int:
         """The farthest node on ``path`` within the move horizon (at least one step)."""

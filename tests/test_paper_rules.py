@@ -4,6 +4,8 @@ each defaults to today's rule."""
 
 from __future__ import annotations
 
+import heapq
+import itertools
 import math
 import subprocess
 import sys
@@ -12,6 +14,7 @@ from typing import Any
 import numpy as np
 import pytest
 
+from ai import search_kernels
 from ai.players import SafetyGraphPlayer
 from ai.view import WorldView
 from game.config import Config
@@ -279,6 +282,51 @@ def test_the_paper_astar_finds_the_least_penalised_path() -> None:
     plain = _paper(graph, safety_penalty=0.0)
     assert len(plain.astar(node, goal, safety)) == 9  # no penalty: straight past the guard
     assert player.astar(node, node, safety) == [node]
+
+
+def _python_astar(node: int, goal: int, indptr: np.ndarray, indices: np.ndarray,
+                  lengths: np.ndarray, penalty: np.ndarray, heuristic: np.ndarray) -> list[int]:
+    """The A* the compiled search replaced, kept as its oracle (heapq, dict costs)."""
+    cost, parent, closed = {node: 0.0}, {}, set()
+    counter = itertools.count()
+    open_list = [(float(heuristic[node]), next(counter), node)]
+    while open_list:
+        _, _, u = heapq.heappop(open_list)
+        if u == goal:
+            path = [u]
+            while path[-1] != node:
+                path.append(parent[path[-1]])
+            return path[::-1]
+        if u in closed:
+            continue
+        closed.add(u)
+        for e in range(indptr[u], indptr[u + 1]):
+            v = int(indices[e])
+            if v in closed:
+                continue
+            g = cost[u] + float(lengths[e] * penalty[v])
+            if g < cost.get(v, math.inf):
+                cost[v], parent[v] = g, u
+                heapq.heappush(open_list, (g + float(heuristic[v]), next(counter), v))
+    return [node]
+
+
+def test_the_compiled_astar_is_the_python_search_with_its_ties() -> None:
+    # open grids with many equally cheap routes (ties broken first in, first out), random
+    # penalties, walls that cut some goals off: the compiled search returns the same path
+    rng = np.random.default_rng(7)
+    for trial in range(40):
+        occupancy = rng.random((9, 11)) < 0.8  # True: free
+        graph = NodeGraph.from_grid(occupancy, 1.0)
+        player = _paper(graph)
+        penalty = np.where(rng.random(graph.n) < 0.5, 1.0, 1.0 + rng.integers(0, 4, graph.n))
+        for _ in range(5):
+            node, goal = (int(v) for v in rng.integers(0, graph.n, 2))
+            heuristic = np.linalg.norm(graph.positions - graph.positions[goal], axis=1)
+            args = (player._indptr, player._indices, player._lengths, penalty.astype(float),
+                    heuristic)
+            compiled = search_kernels.astar(node, goal, *args).tolist()
+            assert compiled == _python_astar(node, goal, *args), (trial, node, goal)
 
 
 def test_the_paper_plan_is_made_once_per_decision_tick() -> None:

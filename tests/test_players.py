@@ -7,7 +7,7 @@ from collections.abc import Sequence
 import numpy as np
 import pytest
 
-from ai import make_player_policy
+from ai import make_player_policy, search_kernels
 from ai.players import MaxMinPlayer, SafetyGraphPlayer, move_sequences
 from ai.view import PlayerPolicy, WorldView
 from navmesh.graph import NodeGraph
@@ -160,3 +160,24 @@ def test_player_params_are_checked() -> None:
         "maxmin", {"maxmin_depth": 2, "guard_speed": 2.0, "player_speed": 2.4}
     )
     assert isinstance(player, MaxMinPlayer) and player.config.maxmin_depth == 2
+
+
+def test_the_compiled_maxmin_score_is_the_array_rule_with_its_ties() -> None:
+    # random distances with many exact ties (values on a coarse lattice, some unreachable):
+    # the compiled scoring keeps the same first moves as the numpy rule it replaced
+    rng = np.random.default_rng(11)
+    for _ in range(300):
+        n, depth = 30, int(rng.integers(1, 4))
+        nearest = rng.integers(0, 6, n).astype(float) * 0.5
+        nearest[rng.random(n) < 0.1] = np.inf
+        paths = rng.integers(0, n, (int(rng.integers(1, 40)), depth))
+        closing = 0.25 * np.arange(1, depth + 1)
+        eps = float(rng.choice([0.0, 1e-9, 0.3]))
+        along = nearest[paths] - closing
+        score = along.min(axis=1)
+        best = score >= score.max() - eps
+        final = np.where(best, along[:, -1], -np.inf)
+        best &= final >= final.max() - eps
+        expected = np.unique(paths[best, 0])
+        got = search_kernels.maxmin_firsts(nearest, paths, closing, eps)
+        assert got.tolist() == expected.tolist()
