@@ -370,12 +370,15 @@ class NodeGraph:
         Always at least one hop (unless a == b), so a walker makes progress; on the grid call
         it with a horizon below two cell sizes to move one cell at a time.
         """
-        path = self.shortest_path(a, b)
-        if len(path) == 1:
+        if a == b:
             return a
-        along = self.dist_from(int(a))[path]
-        within = np.nonzero(along <= horizon + 1e-9)[0]
-        return path[max(1, int(within[-1]))]
+        from . import path_kernels  # numba: loaded by the first walker that asks
+
+        dist, pred = self.distances.dist_pred(int(a))
+        node = int(path_kernels.step_towards(pred, dist, int(a), int(b), float(horizon)))
+        if node < 0:
+            raise ValueError(f"node {b} is not reachable from node {a}")
+        return node
 
 
 def _pack(table: np.ndarray) -> Neighbours:
