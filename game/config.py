@@ -179,6 +179,8 @@ class Config:
 
     def __init__(self, values: Mapping[str, Any]) -> None:
         self._values = dict(values)
+        #: section name -> its keys (the mapping is immutable, so each is found once)
+        self._sections: dict[str, dict[str, Any]] = {}
 
     @classmethod
     def defaults(cls) -> Config:
@@ -207,12 +209,15 @@ class Config:
 
     def section(self, name: str) -> dict[str, Any]:
         """The keys directly under table ``name`` (not nested tables), prefix stripped."""
-        prefix = name + "."
-        return {
-            k[len(prefix):]: v
-            for k, v in self._values.items()
-            if k.startswith(prefix) and "." not in k[len(prefix):]
-        }
+        found = self._sections.get(name)
+        if found is None:
+            prefix = name + "."
+            found = self._sections[name] = {
+                k[len(prefix):]: v
+                for k, v in self._values.items()
+                if k.startswith(prefix) and "." not in k[len(prefix):]
+            }
+        return dict(found)  # the caller's own copy
 
     def as_dict(self) -> dict[str, Any]:
         return dict(self._values)
