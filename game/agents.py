@@ -87,15 +87,27 @@ def build_space(level: Level) -> pymunk.Space:
     set again, and the walls are added in one call in the same order: pymunk's attribute
     writes cost ~5 µs each, and an env builds a space every episode.
     """
+    space = bodies_space()
+    add_walls(space, level)
+    return space
+
+
+def bodies_space() -> pymunk.Space:
+    """A gravity-free pymunk space without walls (:func:`add_walls` adds them)."""
     space = pymunk.Space()
     space.gravity = (0.0, 0.0)
+    return space
+
+
+def add_walls(space: pymunk.Space, level: Level) -> None:
+    """Add the level's walls to ``space`` (:func:`build_space`'s; the batch engine's
+    spaces get them when first stepped)."""
     walls = []
     for (ax, ay), (bx, by) in level.walls:
         wall = pymunk.Segment(space.static_body, (ax, ay), (bx, by), 0.0)
         wall.filter = WALL_SHAPES
         walls.append(wall)
     space.add(*walls)
-    return space
 
 
 def max_agent_speed(config: Any) -> float:
@@ -286,4 +298,5 @@ class Locomotion:
         return False
 
 
-__all__ = ["AGENT_FILTER", "Agent", "Locomotion", "WALL_QUERY", "build_space", "max_agent_speed"]
+__all__ = ["AGENT_FILTER", "Agent", "Locomotion", "WALL_QUERY", "add_walls", "bodies_space",
+           "build_space", "max_agent_speed"]

@@ -37,15 +37,26 @@ class Senses:
     """
 
     def __init__(self, space: pymunk.Space, fov_deg: float,
-                 walls: np.ndarray | None = None) -> None:
+                 walls: np.ndarray | None = None, *, compiled_lines: bool = False) -> None:
         self.space = space
         self.cos_half_fov = math.cos(math.radians(float(fov_deg)) / 2)
         #: the space's walls as (m, 2, 2) ends, when the caller has them: the many-point
         #: :meth:`visible_points` then runs compiled (the same query, bit for bit)
         self.walls = None if walls is None else np.asarray(walls, dtype=np.float64)
+        #: lines of sight by the compiled port of pymunk's query (``game.exact``) over
+        #: ``walls``, for a space that does not hold them (the batch engine's worlds)
+        self.compiled_lines = compiled_lines
+        if compiled_lines and self.walls is None:
+            raise ValueError("compiled lines of sight need the walls")
 
     def clear_line(self, a: Point, b: Point) -> bool:
         """No wall between ``a`` and ``b``."""
+        if self.compiled_lines:
+            from .exact import clear_line, wall_grid
+
+            assert self.walls is not None
+            return bool(clear_line(*wall_grid(self.walls).arrays, float(a[0]), float(a[1]),
+                                   float(b[0]), float(b[1])))
         return self.space.segment_query_first(a, b, 0.0, WALL_QUERY) is None
 
     def in_cone(self, origin: Point, heading: float, target: Point) -> bool:

@@ -19,7 +19,7 @@ from navmesh.level import Level
 
 from .action_params import ActionParams
 from .actions import PlayerActions, Refused
-from .agents import Agent, Locomotion, build_space
+from .agents import Agent, Locomotion, bodies_space, build_space
 from .config import Config
 from .guard_sight import GuardSight, ViewCover
 from .health import Health
@@ -46,7 +46,7 @@ class World(PlayerActions):
         seed: int = 0,
         rngs: Generators | None = None,
         interactive: bool = False, graph: NodeGraph | None = None,
-        stimuli: Sequence[StimulusFactory] = (),
+        stimuli: Sequence[StimulusFactory] = (), walls_in_space: bool = True,
     ) -> None:
         if scenario not in SCENARIOS:
             raise ValueError(f"unknown scenario {scenario!r} (choose capture or fixed)")
@@ -96,8 +96,12 @@ class World(PlayerActions):
         self.health = Health(self.hp_max, self.dt)
 
         self._watched: frozenset[int] = frozenset()
-        self.space = build_space(level)
-        self.senses = Senses(self.space, float(w["fov_deg"]), level.walls)
+        # walls_in_space=False (the batch engine, which steps a space only when a body
+        # touches a wall): the space holds the bodies alone until add_walls, and lines of
+        # sight use the compiled port of pymunk's query over the level's walls
+        self.space = build_space(level) if walls_in_space else bodies_space()
+        self.senses = Senses(self.space, float(w["fov_deg"]), level.walls,
+                             compiled_lines=not walls_in_space)
         self.locomotion = Locomotion(self.space, self.graph, level, self.radius, self.dt)
         self.step_index = 0
         self.done = False

@@ -350,3 +350,26 @@ def test_compiled_visible_points_equal_the_pymunk_ones(name: str) -> None:
         assert np.array_equal(want, got)
         seen += int(want.sum())
     assert seen > 100  # the origins saw something: the masks are not trivially empty
+
+
+@pytest.mark.parametrize("name", ["arkham", "maze"])
+def test_compiled_lines_of_sight_need_no_walls_in_the_space(name: str) -> None:
+    # the batch engine's worlds keep the walls out of their spaces: their senses answer
+    # every perceives() as a space with the walls does
+    from game.agents import bodies_space
+    from game.senses import Senses
+
+    level = cached_level(name)
+    reference = Senses(build_space(level), 90.0)
+    compiled = Senses(bodies_space(), 90.0, level.walls, compiled_lines=True)
+    pts = np.asarray(level.walls, dtype=np.float64).reshape(-1, 2)
+    lo, hi = pts.min(axis=0), pts.max(axis=0)
+    rng = np.random.default_rng(5)
+    blocked = 0
+    for a, b in zip(rng.uniform(lo, hi, (2000, 2)).tolist(), rng.uniform(lo, hi, (2000, 2)).tolist()):
+        want = reference.perceives(tuple(a), None, tuple(b), 1e9)
+        assert compiled.perceives(tuple(a), None, tuple(b), 1e9) == want
+        blocked += not want
+    assert 100 < blocked < 1990  # both answers occur
+    with pytest.raises(ValueError, match="need the walls"):
+        Senses(bodies_space(), 90.0, compiled_lines=True)

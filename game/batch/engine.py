@@ -25,7 +25,7 @@ from ai.view import PlayerPolicy
 from navmesh.graph import NodeGraph, graph_for
 from navmesh.level import cached_level
 
-from ..agents import Agent
+from ..agents import Agent, add_walls
 from ..config import Config
 from ..team import SECTIONS
 from ..trial import TrialSpec, make_world, trial_row
@@ -96,7 +96,12 @@ class Batch:
             raise ValueError(refusal_text(problem))
         level = cached_level(first.level)
         # one config for all: the trials share their settings (Config is read-only)
-        self.worlds = [make_world(spec, config, level=level) for spec in specs]
+        # their spaces hold the bodies alone: the walls are added when a trial first takes
+        # a step in pymunk's hands (most never do; building the walls cost a third of a world)
+        self.worlds = [make_world(spec, config, level=level, walls_in_space=False)
+                       for spec in specs]
+        self.level = level
+        self.space_walls = np.zeros(len(specs), dtype=np.bool_)
         w0 = self.worlds[0]
         self.graph: NodeGraph = w0.graph
         self.dt, self.radius = w0.dt, w0.radius
@@ -389,6 +394,9 @@ class Batch:
         solver is the reference's (the kernels move bodies only where nothing touches)."""
         for b in trials.tolist():
             world = self.worlds[b]
+            if not self.space_walls[b]:
+                add_walls(world.space, self.level)
+                self.space_walls[b] = True
             agents = self.agents(b)
             for a, agent in enumerate(agents):
                 agent.body.position = (float(before[b, a, 0]), float(before[b, a, 1]))
