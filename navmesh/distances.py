@@ -221,6 +221,16 @@ class Distances:
         """``min_s d(s, target)`` over the (non-empty) ``nodes``."""
         return float(self.nearest(nodes, None)[target])
 
+    def nearest_to_rows(self, srcs: np.ndarray, targets: np.ndarray) -> np.ndarray:
+        """(k,) :meth:`nearest_to` of each row: ``min_j d(srcs[i, j], targets[i])`` over
+        the row's sources (entries < 0 are none; ``inf`` for a row without any)."""
+        out = np.full(len(targets), np.inf)
+        for i, (row, target) in enumerate(zip(srcs.tolist(), targets.tolist(), strict=True)):
+            nodes = np.array([s for s in row if s >= 0], dtype=np.intp)
+            if len(nodes):
+                out[i] = self.nearest_to(nodes, int(target))
+        return out
+
     def _pairwise(self, a: Any, b: Any, row: Callable[[int], np.ndarray], dtype: type) -> np.ndarray:
         """Each pair's value from one per-source row per source."""
         a_arr, b_arr = np.broadcast_arrays(np.asarray(a, dtype=np.intp), np.asarray(b, dtype=np.intp))
@@ -286,6 +296,10 @@ class DenseDistances(Distances):
 
     def nearest_to(self, nodes: np.ndarray, target: int) -> float:
         return float(self._dist[nodes, target].min())
+
+    def nearest_to_rows(self, srcs: np.ndarray, targets: np.ndarray) -> np.ndarray:
+        found = self._dist[np.maximum(srcs, 0), np.asarray(targets)[:, None]]
+        return np.where(srcs >= 0, found, np.inf).min(axis=1, initial=np.inf)
 
 
 class SearchedDistances(Distances):

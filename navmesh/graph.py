@@ -334,6 +334,12 @@ class NodeGraph:
             return np.inf
         return self.distances.nearest_to(nodes, int(target))
 
+    def nearest_dist_to_rows(self, srcs: np.ndarray, targets: np.ndarray) -> np.ndarray:
+        """(k,) :meth:`nearest_dist_to` of many source sets at once: row i of ``srcs``
+        (k, g) holds the sources of ``targets[i]``, entries < 0 none (``inf``: no source)."""
+        srcs = np.asarray(srcs, dtype=np.intp).reshape(len(targets), -1)
+        return self.distances.nearest_to_rows(srcs, np.asarray(targets, dtype=np.intp))
+
     def components(self) -> np.ndarray:
         """(n,) label of every node's connected piece."""
         if self._labels is None:

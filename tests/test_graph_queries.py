@@ -127,6 +127,20 @@ def test_nearest_distances_equal_the_min_over_rows(pair: tuple[NodeGraph, NodeGr
             assert np.array_equal(near[close], rows[close])
 
 
+def test_nearest_distances_of_many_rows_are_each_rows_own(pair: tuple[NodeGraph, NodeGraph]) -> None:
+    # the batch engine's distance samples: one call for every trial whose nodes changed
+    dense, sparse = pair
+    rng = np.random.default_rng(8)
+    srcs = rng.integers(-1, dense.n, size=(30, 4))
+    srcs[3] = -1  # a row without a source (every guard out of play)
+    targets = rng.integers(dense.n, size=30)
+    want = [dense.nearest_dist_to([s for s in row if s >= 0], int(t))
+            for row, t in zip(srcs.tolist(), targets.tolist())]
+    assert want[3] == np.inf and np.isfinite(want).sum() > 20
+    assert dense.nearest_dist_to_rows(srcs, targets).tolist() == want
+    assert sparse.nearest_dist_to_rows(srcs, targets).tolist() == want
+
+
 def test_decisions_on_a_searched_graph_equal_the_dense_ones(pair: tuple[NodeGraph, NodeGraph]) -> None:
     """A large graph's field reads K at a decision's candidates alone (kernel_at) and the
     spreads from their balls: the scores, winners and explanations stay bit for bit."""

@@ -216,16 +216,19 @@ class Batch:
     def _decide(self, b: int, askers: list[int]) -> None:
         """:meth:`World.decide` in trial ``b``, whose agents ``askers`` have no plan: only
         they change (a policy's actions may change any agent: then all are read back)."""
+        world = self.worlds[b]
+        if self.acting[b]:
+            self.pull(b)
+            world.decide()
+            self.push(b)
+            return
         self.pull_view(b)
         for a in askers:
             self.pull(b, a)
-        world = self.worlds[b]
         world.decide()
-        if self.acting[b]:
-            self.push(b)
-            return
-        for a in askers:
-            self.push(b, a)
+        agents = self.agents(b)
+        for a in askers:  # a plan sets the target, the waypoints and the clock alone
+            self._push_walk(b, a, agents[a])
 
     def push(self, b: int, only: int | None = None) -> None:
         """Read trial ``b``'s world back into the arrays (one agent: ``only``)."""
@@ -238,25 +241,29 @@ class Batch:
             if agent.velocity != (self.cmd[b, a, 0], self.cmd[b, a, 1]):  # set_velocity wrote
                 self.cmd[b, a, 0], self.cmd[b, a, 1] = agent.velocity
                 self.vel[b, a, 0], self.vel[b, a, 1] = agent.velocity
-            waypoints = agent.waypoints
-            self.has_wp[b, a] = bool(waypoints)
-            self.n_wp[b, a] = len(waypoints)
-            if waypoints:
-                self.wp[b, a, 0], self.wp[b, a, 1] = waypoints[0]
-            cruise = agent.cruise
-            ok = cruise is not None and bool(waypoints) and cruise[0] is waypoints[0]
-            self.cruise_ok[b, a] = ok
-            if ok:
-                assert cruise is not None
-                self.cruise_speed[b, a], self.cruise_rem[b, a] = cruise[1], cruise[2]
+            self._push_walk(b, a, agent)
             self.on_track[b, a] = agent.on_track
-            self.since[b, a] = agent.since_target
             self.node[b, a] = agent.node
             self.active[b, a] = agent.active
             self.heading[b, a] = agent.heading
             self.speed[b, a] = world.player_step_speed() if a == last else agent.speed
         self.seen[b] = _bits(world.seen_by)
         self.sprinting[b] = world.sprinting
+
+    def _push_walk(self, b: int, a: int, agent: Agent) -> None:
+        """Read agent ``a``'s walk back: waypoints, cruise and the time since its target."""
+        waypoints = agent.waypoints
+        self.has_wp[b, a] = bool(waypoints)
+        self.n_wp[b, a] = len(waypoints)
+        if waypoints:
+            self.wp[b, a, 0], self.wp[b, a, 1] = waypoints[0]
+        cruise = agent.cruise
+        ok = cruise is not None and bool(waypoints) and cruise[0] is waypoints[0]
+        self.cruise_ok[b, a] = ok
+        if ok:
+            assert cruise is not None
+            self.cruise_speed[b, a], self.cruise_rem[b, a] = cruise[1], cruise[2]
+        self.since[b, a] = agent.since_target
 
     # ------------------------------------------------------------------ one step
     def step(self) -> None:
@@ -371,23 +378,26 @@ class Batch:
             world.step_index = self.step_index
             world.detect(_guards(int(self.seeing[b])))
             self.seen[b] = _bits(world.seen_by)
-        for b in np.flatnonzero(live & self.key_changed).tolist():
-            self._new_distance(b)
+        changed = np.flatnonzero(live & self.key_changed)
+        if len(changed):
+            self._new_distances(changed)
 
-    def _new_distance(self, b: int) -> None:
-        """The path distance of trial ``b``'s new nodes, asked of the graph as
-        ``Counters.sample_distance`` asks it, and this step's sample."""
+    def _new_distances(self, trials: np.ndarray) -> None:
+        """The path distance of the trials whose nodes changed, asked of the graph as
+        ``Counters.sample_distance`` asks it (the active guards' nearest to the player),
+        and this step's sample."""
         p = self.node.shape[1] - 1
-        guards = [int(self.node[b, g]) for g in range(p) if self.active[b, g]]
-        self.key[b, :p] = np.where(self.active[b, :p], self.node[b, :p], -1)
-        self.key[b, p] = self.node[b, p]
-        if guards:
-            self.dist_now[b] = self.graph.nearest_dist_to(guards, int(self.node[b, p]))
-            self.has_dist[b] = True
-            self.dist_sum[b] = float(self.dist_sum[b]) + float(self.dist_now[b])
-            self.dist_n[b] += 1
-        else:
-            self.has_dist[b] = False
+        active = self.active[trials, :p]
+        guards = np.where(active, self.node[trials, :p], -1)
+        self.key[trials, :p] = guards
+        self.key[trials, p] = self.node[trials, p]
+        found = self.graph.nearest_dist_to_rows(guards, self.node[trials, p])
+        has = active.any(axis=1)
+        self.has_dist[trials] = has
+        sampled = trials[has]
+        self.dist_now[sampled] = found[has]
+        self.dist_sum[sampled] += found[has]
+        self.dist_n[sampled] += 1
 
     def _pymunk_step(self, trials: np.ndarray, before: np.ndarray) -> None:
         """Trials with a body at a wall take this step in their own pymunk space, whose
