@@ -9,6 +9,7 @@ from __future__ import annotations
 import concurrent.futures as cf
 from typing import Any
 
+import numpy as np
 import pytest
 
 from game.batch import MAX_BATCH, Batch, run_trials, uncovered
@@ -63,6 +64,22 @@ def test_a_batch_ends_each_trial_at_its_own_time() -> None:
         steps += 1
     ends = {w.step_index for w in batch.worlds}
     assert max(ends) == steps and len(ends) > 1
+
+
+def test_each_trial_keeps_its_own_clock_when_some_are_held() -> None:
+    # a vector env holds the trials whose move has ended while the others step on: a trial
+    # held for a while then stepped again ends as it does stepped without a break
+    specs = _paper("miami", "grid")[:6]
+    batch = Batch(specs)
+    rate = np.arange(len(specs)) % 3 + 1  # trial b steps once every rate[b] calls
+    calls = apart = 0
+    while batch.live.any():
+        batch.step(calls % rate == 0)
+        calls += 1
+        apart = max(apart, int(np.ptp(batch.clock)))
+    assert apart > 300  # the clocks ran far apart on the way
+    held = [_result(r) for r in batch.run()]
+    assert held == [_result(run_trial(s)) for s in specs]
 
 
 def test_trials_of_different_levels_or_settings_are_not_one_batch() -> None:

@@ -177,7 +177,8 @@ class Batch:
         self.acting = np.array([w.player_policy is not None
                                 and type(w.player_policy).actions is not PlayerPolicy.actions
                                 for w in self.worlds], dtype=np.bool_)
-        self.step_index = 0
+        #: each trial's own clock: physics steps it has taken (World.step_index)
+        self.clock = np.zeros(n_trials, dtype=np.int64)
 
     def agents(self, b: int) -> list[Agent]:
         """Trial ``b``'s agents in array order: the guards, then the player."""
@@ -187,7 +188,7 @@ class Batch:
     def pull(self, b: int, only: int | None = None) -> None:
         """Write the arrays into trial ``b``'s world (one agent: ``only``)."""
         world = self.worlds[b]
-        world.step_index = self.step_index
+        world.step_index = int(self.clock[b])
         world.attackers = int(self.attackers[b])
         agents = self.agents(b)
         pos, on_track, since = self.pos[b].tolist(), self.on_track[b], self.since[b]
@@ -206,7 +207,7 @@ class Batch:
         """Write what a :class:`~ai.view.WorldView` and a plan read (clock, positions,
         headings) into trial ``b``'s world; nothing it would write back."""
         world = self.worlds[b]
-        world.step_index = self.step_index
+        world.step_index = int(self.clock[b])
         world.attackers = int(self.attackers[b])
         heading = self.heading[b].tolist()
         for agent, (x, y), h in zip(self.agents(b), self.pos[b].tolist(), heading):
@@ -266,14 +267,18 @@ class Batch:
         self.since[b, a] = agent.since_target
 
     # ------------------------------------------------------------------ one step
-    def step(self) -> None:
-        """One physics step of every live trial: :meth:`World.step`'s phases in its order."""
-        live, dt = self.live, self.dt
-        if self.step_index % self.steps_per_decision == 0:  # World.decide's askers
+    def step(self, advance: np.ndarray | None = None) -> None:
+        """One physics step of every live trial (of those ``advance`` marks, when given: a
+        vector env holds a trial whose move has ended while the others finish theirs):
+        :meth:`World.step`'s phases in its order, each trial on its own clock."""
+        live = self.live.copy() if advance is None else self.live & advance
+        dt, clock = self.dt, self.clock
+        due = live & (clock % self.steps_per_decision == 0)  # World.decide's askers
+        if due.any():
             idle = ~self.has_wp
             idle[:, :-1] &= self.active[:, :-1]
             idle[:, -1] &= self.has_policy
-            for b in np.flatnonzero(live & idle.any(axis=1)).tolist():
+            for b in np.flatnonzero(due & idle.any(axis=1)).tolist():
                 self._decide(b, np.flatnonzero(idle[b]).tolist())
         kernels.drive(live, self.active, self.has_wp, self.wp, self.pos, self.cruise_ok,
                       self.cruise_speed, self.cruise_rem, self.on_track, self.speed, self.cmd,
@@ -287,12 +292,12 @@ class Batch:
         # pymunk's solver answers a contact with a velocity and a bias it applies over the
         # next steps (cpBody's v_bias, its arbiters kept 3 steps): such a trial takes this
         # step and the next three in its own space
-        self.held[self.touch] = 4
+        self.held[self.touch] = 4  # (touch is False for a trial not stepped)
         held = live & (self.held > 0)
         if held.any():
             self._pymunk_step(np.flatnonzero(held), before)
             self.held[held] -= 1
-        self.step_index += 1
+        clock[live] += 1
         for b in np.flatnonzero(live & (self.attackers > 0)).tolist():
             self._hurt(b, before)
         kernels.settle(live, self.pos, before, self.has_wp, self.n_wp, self.wp, self.cruise_ok,
@@ -306,26 +311,26 @@ class Batch:
         for b in np.flatnonzero(live & self.sprinting).tolist():  # footsteps: the world's rule
             self.pull(b)
             self.worlds[b].moved((float(before[b, -1, 0]), float(before[b, -1, 1])), True)
-        self._sense()
-        if self.step_index % self.steps_per_tick == 0:
-            for b in np.flatnonzero(live).tolist():
-                # the tick reads where the agents are and changes none of them (the rules
-                # that would: team switches, plugin stimuli, are not covered)
-                self.pull_view(b)
-                self.worlds[b].end_step()
-                self.ended[b] = self.worlds[b].done
-        elif self.step_index >= self.total_steps:
-            for b in np.flatnonzero(live).tolist():
-                self.worlds[b].done = True
-            self.ended[live] = True
-        live[self.ended] = False
+        self._sense(live)
+        tick = live & (clock % self.steps_per_tick == 0)
+        for b in np.flatnonzero(tick).tolist():
+            # the tick reads where the agents are and changes none of them (the rules
+            # that would: team switches, plugin stimuli, are not covered)
+            self.pull_view(b)
+            self.worlds[b].end_step()
+            self.ended[b] = self.worlds[b].done
+        over = live & ~tick & (clock >= self.total_steps)  # World.end_step's other rule
+        for b in np.flatnonzero(over).tolist():
+            self.worlds[b].done = True
+        self.ended[over] = True
+        self.live[self.ended] = False
 
     def _settle(self, b: int, a: int, kind: int, before: np.ndarray, speeds: np.ndarray) -> None:
         """What :func:`kernels.settle` flagged for agent ``a`` of trial ``b``: a node entered
         or the target reached run the world's rule alone (the kernel committed the rest);
         anything else is :meth:`World.settle_agent` on the agent's whole state."""
         world = self.worlds[b]
-        world.step_index = self.step_index
+        world.step_index = int(self.clock[b])
         agent = self.agents(b)[a]
         if kind == kernels.ENTERED:
             world.enter_node(agent, int(self.new_node[b, a]), a)
@@ -348,7 +353,7 @@ class Batch:
         world = self.worlds[b]
         attackers = int(self.attackers[b])
         if not world.health.lethal(attackers):  # damage alone: no agent moves, none is read
-            world.step_index, world.attackers = self.step_index, attackers
+            world.step_index, world.attackers = int(self.clock[b]), attackers
             world.hurt((0.0, 0.0))
             return
         self.pull(b)
@@ -365,17 +370,16 @@ class Batch:
             agent.pos = (float(self.pos[b, a, 0]), float(self.pos[b, a, 1]))
         self.push(b)
 
-    def _sense(self) -> None:
+    def _sense(self, live: np.ndarray) -> None:
         w = self.walls
-        kernels.sense(self.live, self.pos, self.heading, self.active, self.node, self.view_range,
+        kernels.sense(live, self.pos, self.heading, self.active, self.node, self.view_range,
                       self.view_scale_at, self.attack_range, self.attack_los, self.cos_half_fov,
                       w.segs, w.cell_start, w.cell_items, w.geom, self.key, self.dist_now,
                       self.has_dist, self.dist_sum, self.dist_n, self.euc_sum, self.euc_n,
                       self.seeing, self.attackers, self.key_changed)
-        live = self.live
         for b in np.flatnonzero(live & ((self.seeing != 0) | (self.seen != 0))).tolist():
             world = self.worlds[b]
-            world.step_index = self.step_index
+            world.step_index = int(self.clock[b])
             world.detect(_guards(int(self.seeing[b])))
             self.seen[b] = _bits(world.seen_by)
         changed = np.flatnonzero(live & self.key_changed)
