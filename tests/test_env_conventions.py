@@ -165,22 +165,6 @@ def test_the_registered_env_has_a_step_limit_that_can_be_changed() -> None:
     assert math.isclose(info["t"], 1.0)  # the env's own clock ended it
 
 
-def test_the_vector_entry_point_takes_the_step_limit() -> None:
-    kinds = {"num_envs": 2, "vectorization_mode": "vector_entry_point", "level": "maze"}
-    vec = gymnasium.make_vec(ENV_ID, **kinds)  # make_vec passes the registered limit
-    limit = vec.envs[0]
-    assert isinstance(limit, gymnasium.wrappers.TimeLimit)
-    assert limit._max_episode_steps == MAX_EPISODE_STEPS
-    vec = gymnasium.make_vec(ENV_ID, max_episode_steps=2, **kinds)
-    vec.reset(seed=0)
-    truncated = [vec.step(np.zeros(2, dtype=np.int64))[3].tolist() for _ in range(2)]
-    assert truncated == [[False, False], [True, True]]
-    assert isinstance(gymnasium.make_vec(ENV_ID, max_episode_steps=-1, **kinds).envs[0],
-                      StealthEnv)  # no TimeLimit around the world
-    with pytest.raises(ValueError, match="max_episode_steps must be"):
-        gymnasium.make_vec(ENV_ID, max_episode_steps=0, **kinds)
-
-
 @pytest.mark.parametrize("kind", ["dict", "image"])
 def test_dict_and_image_observations_pass_check_env(kind: str) -> None:
     one = StealthEnv("maze", observation=kind, world__duration=6.0)

@@ -79,27 +79,33 @@ def run_trials(specs: Sequence[TrialSpec]) -> list[dict[str, Any]]:
 class Batch:
     """Trials sharing level, abstraction and config, stepped together."""
 
-    def __init__(self, specs: Sequence[TrialSpec]) -> None:
+    def __init__(self, specs: Sequence[TrialSpec], worlds: Sequence[World] | None = None) -> None:
+        """The trials ``specs``, their worlds built here, or ``worlds`` built by the caller
+        (a vector env's: made with ``walls_in_space=False``, one level, graph and config)."""
         if not specs:
             raise ValueError("a batch needs at least one trial")
         self.started = time.perf_counter()
         self.specs = list(specs)
         first = specs[0]
-        shared = (first.level, first.abstraction, first.settings, first.stimuli)
-        for spec in specs:
-            if (spec.level, spec.abstraction, spec.settings, spec.stimuli) != shared:
-                raise ValueError("a batch's trials share level, abstraction, settings and "
-                                 f"stimuli: {spec.key} differs from {first.key}")
-        config = Config.load({**first.settings, "world.engine": "batch"})  # rows say so
-        problem = uncovered(first, config)
-        if problem is not None:
-            raise ValueError(refusal_text(problem))
         level = cached_level(first.level)
-        # one config for all: the trials share their settings (Config is read-only)
-        # their spaces hold the bodies alone: the walls are added when a trial first takes
-        # a step in pymunk's hands (most never do; building the walls cost a third of a world)
-        self.worlds = [make_world(spec, config, level=level, walls_in_space=False)
-                       for spec in specs]
+        if worlds is None:
+            shared = (first.level, first.abstraction, first.settings, first.stimuli)
+            for spec in specs:
+                if (spec.level, spec.abstraction, spec.settings, spec.stimuli) != shared:
+                    raise ValueError("a batch's trials share level, abstraction, settings and "
+                                     f"stimuli: {spec.key} differs from {first.key}")
+            config = Config.load({**first.settings, "world.engine": "batch"})  # rows say so
+            problem = uncovered(first, config)
+            if problem is not None:
+                raise ValueError(refusal_text(problem))
+            # one config for all: the trials share their settings (Config is read-only);
+            # their spaces hold the bodies alone: the walls are added when a trial first
+            # takes a step in pymunk's hands (most never do; the walls cost a third of a world)
+            worlds = [make_world(spec, config, level=level, walls_in_space=False)
+                      for spec in specs]
+        elif len(worlds) != len(specs) or not all(w.senses.compiled_lines for w in worlds):
+            raise ValueError("a batch takes one world per trial, built with walls_in_space=False")
+        self.worlds = list(worlds)
         self.level = level
         self.space_walls = np.zeros(len(specs), dtype=np.bool_)
         w0 = self.worlds[0]
@@ -127,15 +133,11 @@ class Batch:
             self.locate_start = np.ascontiguousarray(mesh._cell_start, dtype=np.int64)
             self.locate_items = np.ascontiguousarray(mesh._cell_items, dtype=np.int64)
         self._arrays()
-        for b in range(len(self.worlds)):
-            self.push(b)
 
     # ------------------------------------------------------------------ state
     def _arrays(self) -> None:
         n_trials = len(self.worlds)
         n_agents = len(self.worlds[0].guards) + 1
-        if any(len(w.guards) + 1 != n_agents for w in self.worlds):
-            raise ValueError("a batch's trials have one number of guards")
         shape = (n_trials, n_agents)
         self.pos = np.zeros(shape + (2,))
         self.vel = np.zeros(shape + (2,))
@@ -154,8 +156,8 @@ class Batch:
         self.active = np.zeros(shape, dtype=np.bool_)
         self.speed = np.zeros(shape)
         self.heading = np.zeros(shape)
-        self.live = np.array([not w.done for w in self.worlds], dtype=np.bool_)
-        self.view_range = np.array([w.view_range for w in self.worlds], dtype=np.float64)
+        self.live = np.zeros(n_trials, dtype=np.bool_)
+        self.view_range = np.zeros(n_trials)
         self.key = np.full(shape, -2, dtype=np.int64)  # the nodes of the last distance sample
         self.dist_now = np.zeros(n_trials)
         self.has_dist = np.zeros(n_trials, dtype=np.bool_)
@@ -164,21 +166,48 @@ class Batch:
         self.euc_sum = np.zeros(n_trials)
         self.euc_n = np.zeros(n_trials, dtype=np.int64)
         self.seeing = np.zeros(n_trials, dtype=np.int64)
-        self.seen = np.array([_bits(w.seen_by) for w in self.worlds], dtype=np.int64)
-        self.attackers = np.array([w.attackers for w in self.worlds], dtype=np.int64)
+        self.seen = np.zeros(n_trials, dtype=np.int64)
+        self.attackers = np.zeros(n_trials, dtype=np.int64)
         self.key_changed = np.zeros(n_trials, dtype=np.bool_)
         self.touch = np.zeros(n_trials, dtype=np.bool_)
         self.held = np.zeros(n_trials, dtype=np.int64)  # steps left in pymunk's hands
-        self.ended = ~self.live  # trials whose world is done: not stepped after this step
+        self.ended = np.zeros(n_trials, dtype=np.bool_)  # done: not stepped after this step
         self.sprinting = np.zeros(n_trials, dtype=np.bool_)
-        self.has_policy = np.array([w.player_policy is not None for w in self.worlds],
-                                   dtype=np.bool_)
+        self.has_policy = np.zeros(n_trials, dtype=np.bool_)
         # a player policy with actions of its own (take-downs, throws) may change any agent
-        self.acting = np.array([w.player_policy is not None
-                                and type(w.player_policy).actions is not PlayerPolicy.actions
-                                for w in self.worlds], dtype=np.bool_)
+        self.acting = np.zeros(n_trials, dtype=np.bool_)
         #: each trial's own clock: physics steps it has taken (World.step_index)
         self.clock = np.zeros(n_trials, dtype=np.int64)
+        for b in range(n_trials):
+            self._start(b)
+
+    def _start(self, b: int) -> None:
+        """Trial ``b``'s entries, from its world as built (a new trial)."""
+        world = self.worlds[b]
+        if len(world.guards) + 1 != self.pos.shape[1]:
+            raise ValueError("a batch's trials have one number of guards")
+        self.live[b] = not world.done
+        self.ended[b] = world.done
+        self.view_range[b] = world.view_range
+        self.key[b] = -2
+        self.dist_now[b] = self.dist_sum[b] = self.euc_sum[b] = 0.0
+        self.dist_n[b] = self.euc_n[b] = self.held[b] = 0
+        self.has_dist[b] = self.key_changed[b] = self.touch[b] = self.space_walls[b] = False
+        self.seeing[b] = 0
+        self.attackers[b] = world.attackers
+        policy = world.player_policy
+        self.has_policy[b] = policy is not None
+        self.acting[b] = policy is not None and type(policy).actions is not PlayerPolicy.actions
+        self.clock[b] = world.step_index
+        self.cmd[b] = np.nan  # every velocity differs: push reads them all
+        self.push(b)
+
+    def replace(self, b: int, spec: TrialSpec, world: World) -> None:
+        """Trial ``b`` becomes ``spec``'s new ``world`` (a vector env's reset of one env)."""
+        if not world.senses.compiled_lines:
+            raise ValueError("a batch takes worlds built with walls_in_space=False")
+        self.specs[b], self.worlds[b] = spec, world
+        self._start(b)
 
     def agents(self, b: int) -> list[Agent]:
         """Trial ``b``'s agents in array order: the guards, then the player."""

@@ -67,48 +67,11 @@ from .observations import (  # re-exported: the layout's names (docs/api.md)
     STATE_GUARD,
 )
 from .observations import OBS_BOUND
-from .wrappers import OBSERVATIONS, FlatObsWrapper, ImgObsWrapper, Layout
+from .options import check_action, split_options
+from .vector import MAX_NUM_ENVS, StealthVectorEnv
+from .wrappers import OBSERVATIONS, FlatObsWrapper, ImgObsWrapper, player_layout
 
 ENV_ID = "stealthfield/Stealth-v0"
-#: Keyword options of the environments; every other keyword is a config override.
-_OPTIONS = ("render_mode", "obs_radius", "rewards", "render_size", "overrides")
-
-
-def check_action(space: spaces.Discrete, action: Any, who: str = "the agent") -> int:
-    """``action`` as an int, or a ValueError naming it when it is not in ``space``.
-
-    ``Discrete.contains`` refuses floats, strings and out-of-range integers (numpy's
-    ``-1`` included), so ``step(1.7)`` cannot silently become action 1; booleans (Python's
-    or numpy's, which ``contains`` takes) are refused here, so ``step(True)`` is not 1.
-    """
-    kind = type(action)
-    if kind is int or kind is np.int64:  # the usual cases, without contains()'s dtype checks
-        start = int(space.start)
-        if start <= action < start + int(space.n):
-            return int(action)
-    ok = False
-    if not isinstance(action, (bool, np.bool_)) and getattr(action, "dtype", None) != np.bool_:
-        try:
-            ok = space.contains(action)
-        except (TypeError, ValueError):
-            ok = False
-    if not ok:
-        raise ValueError(f"invalid action {action!r} for {who}: expected an integer in "
-                         f"[0, {space.n - 1}] ({space})")
-    return int(action)
-
-
-def _split_options(level: str, abstraction: str, scenario: str, kwargs: dict[str, Any]
-                   ) -> tuple[dict[str, Any], dict[str, Any]]:
-    """Env options and config overrides (``world__guards=2`` means ``world.guards=2``)."""
-    options = {k: kwargs.pop(k) for k in _OPTIONS if k in kwargs}
-    given = options.pop("overrides", None)
-    if given is not None and not isinstance(given, Mapping):
-        raise ValueError(f"overrides must be a dict of config keys, not {given!r}")
-    overrides = dict(given or {})
-    for key, value in kwargs.items():
-        overrides[key.replace("__", ".")] = value
-    return options, overrides
 
 
 # ---------------------------------------------------------------------------- PettingZoo
@@ -157,7 +120,7 @@ class StealthParallelEnv(ParallelEnv):
                  **config: Any) -> None:
         if not isinstance(pad_observations, (bool, np.bool_)):
             raise ValueError(f"pad_observations must be True or False, not {pad_observations!r}")
-        options, overrides = _split_options(level, abstraction, scenario, config)
+        options, overrides = split_options(level, abstraction, scenario, config)
         self.match = Match(level, abstraction, scenario, None, overrides, **options)
         self.render_mode = self.match.render_mode
         self.possible_agents = [PLAYER] + [f"guard_{i}" for i in range(self.match.n_guards)]
@@ -328,15 +291,12 @@ class StealthEnv(gymnasium.Env):
         if observation not in OBSERVATIONS:
             raise ValueError(f"unknown observation {observation!r} "
                              f"(choose from {', '.join(OBSERVATIONS)})")
-        options, overrides = _split_options(level, abstraction, scenario, config)
+        options, overrides = split_options(level, abstraction, scenario, config)
         self.match = Match(level, abstraction, scenario, guards, overrides, **options)
         self.render_mode = self.match.render_mode
-        observer = self.match.observer
-        side = 2 * observer.radius + 1
-        window = len(PLAYER_CHANNELS) * side * side
         #: ``"flat"``, ``"dict"`` or ``"image"`` (game.env.wrappers)
         self.observation = observation
-        self._layout = Layout(len(PLAYER_CHANNELS), side, observer.obs_size(False) - window)
+        self._layout = player_layout(self.match.observer)
         self.observation_space = self._layout.space(observation)
         self._actions = spaces.Discrete(self.match.n_actions)
         self.action_space = self._actions
@@ -368,46 +328,6 @@ class StealthEnv(gymnasium.Env):
 
     def close(self) -> None:
         self.match.close()
-
-
-#: The most worlds one :class:`StealthVectorEnv` steps in turn in one process (10^9 ran
-#: out of memory after 38 s); more belong in several processes.
-MAX_NUM_ENVS = 1024
-
-
-class StealthVectorEnv(gymnasium.vector.SyncVectorEnv):
-    """``num_envs`` :class:`StealthEnv` worlds stepped in turn in this process.
-
-    What ``gymnasium.make_vec("stealthfield/Stealth-v0", num_envs=n,
-    vectorization_mode="vector_entry_point", level=...)`` builds: the worlds share the
-    level, its graph and its move table (cached per process), so n worlds cost one level's
-    set-up; ``reset(seed=s)`` plays seeds ``s, s + 1, ...``; ``action_masks()`` stacks the
-    worlds' masks (n, actions). ``max_episode_steps`` (which ``make_vec`` passes: the
-    registered :data:`MAX_EPISODE_STEPS` unless given) wraps every world in ``TimeLimit``
-    as ``gymnasium.make`` does; ``None`` or ``-1``: no limit but the env's own clock.
-    """
-
-    def __init__(self, num_envs: int = 1, max_episode_steps: int | None = None,
-                 **kwargs: Any) -> None:
-        if isinstance(num_envs, bool) or not isinstance(num_envs, (int, np.integer)) \
-                or not 1 <= num_envs <= MAX_NUM_ENVS:
-            raise ValueError(f"num_envs must be a whole number in [1, {MAX_NUM_ENVS}], "
-                             f"not {num_envs!r}")
-        limit = max_episode_steps
-        if limit is not None and (isinstance(limit, bool) or not isinstance(limit, (int, np.integer))
-                                  or not (limit == -1 or limit >= 1)):
-            raise ValueError(f"max_episode_steps must be a whole number >= 1 (or -1 or None: "
-                             f"no limit), not {limit!r}")
-
-        def make() -> gymnasium.Env:
-            one = StealthEnv(**kwargs)
-            return one if limit is None or limit == -1 else \
-                gymnasium.wrappers.TimeLimit(one, int(limit))
-
-        super().__init__([make for _ in range(int(num_envs))])
-
-    def action_masks(self) -> np.ndarray:
-        return np.stack([env.unwrapped.action_masks() for env in self.envs])  # type: ignore[attr-defined]
 
 
 #: ``spec.max_episode_steps`` of the registered env: the default episode (60 s) in physics

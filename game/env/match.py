@@ -9,6 +9,7 @@ one player move.
 from __future__ import annotations
 
 import math
+import weakref
 from collections.abc import Mapping
 from typing import Any
 
@@ -26,8 +27,8 @@ from .observations import OBS_BOUND, Observer
 from ..trial import TrialSpec, make_world
 from ..world import SCENARIOS, World
 
-__all__ = ["ExternalGuards", "ExternalPlayer", "GRID_ACTIONS", "Match", "PARTITION_ACTIONS",
-           "REWARDS"]
+__all__ = ["ExternalGuards", "ExternalPlayer", "GRID_ACTIONS", "Match", "Move",
+           "PARTITION_ACTIONS", "REWARDS"]
 
 #: Grid actions (Discrete(5)): stay and the four neighbouring cells (y grows downwards).
 GRID_ACTIONS = ("stay", "north", "east", "south", "west")
@@ -43,6 +44,19 @@ PARTITION_ACTIONS = ("stay", "north", "northeast", "east", "southeast",
 #: score, seconds survived, less 1 per HP and 3 per capture (what the fixed-time scenario,
 #: whose clock always runs out, scores); a step is worth about ±0.5 (issue 23).
 REWARDS = {"survival": 1.0, "hp": 1.0, "capture": 3.0, "seen": 1.0, "proximity": 3.0}
+
+
+#: each graph's move table, built once (a read-only array shared by every env on the graph)
+_MOVES: weakref.WeakKeyDictionary[NodeGraph, np.ndarray] = weakref.WeakKeyDictionary()
+
+
+def direction_table(graph: NodeGraph) -> np.ndarray:
+    """:func:`_direction_table` of ``graph``, built once per graph (read-only)."""
+    moves = _MOVES.get(graph)
+    if moves is None:
+        moves = _MOVES[graph] = _direction_table(graph)
+        moves.flags.writeable = False
+    return moves
 
 
 def _direction_table(graph: NodeGraph) -> np.ndarray:
@@ -174,6 +188,57 @@ class ExternalGuards(PotentialFieldGuards):
         return self.mode
 
 
+class Move:
+    """One player move in progress (:meth:`Match.begin_move`): after each physics step of
+    the match's world, :meth:`after_step` says whether the move is over — the world's
+    trial ended, the player respawned, its target reached (a "stay": held as long as a move
+    takes), a second decision began, or :attr:`Match.max_steps` passed — and
+    :meth:`result` gives its reward, termination and truncation."""
+
+    def __init__(self, match: Match) -> None:
+        self.match = match
+        w = match.world
+        self.hp0, self.t0, self.caps0 = w.hp, w.t, w.m.captures
+        self.hp = self.hp0
+        self.steps = 0
+        self.staying = False
+
+    def after_step(self, pos: tuple[float, float]) -> bool:
+        """The world took one more step and the player stands at ``pos``: is the move over?"""
+        match, w = self.match, self.match.world
+        k, self.steps = self.steps, self.steps + 1
+        if w.done or w.hp > self.hp:  # over, or respawned after a capture (fixed-time)
+            return True
+        self.hp = w.hp
+        player = match.player
+        if player.decisions == 1 and k == 0:
+            self.staying = player.target == w.player.node and match.at(player.target, pos)
+        if player.decisions:
+            if self.staying:
+                if k + 1 >= match.hold_steps:
+                    return True
+            elif player.decisions > 1 or match.at(player.target, pos):
+                return True
+        return self.steps >= match.max_steps
+
+    def result(self) -> tuple[float, bool, bool]:
+        """The move's player reward, terminated and truncated (the world read as it is)."""
+        match, w = self.match, self.match.world
+        captures = w.m.captures - self.caps0
+        ends = match.ends_on_capture
+        if captures and not ends:  # fixed-time: the player respawned with full HP
+            lost = self.hp0 + (captures - 1) * match.hp_max + (match.hp_max - w.hp)
+        else:
+            lost = self.hp0 - max(0.0, w.hp)
+        danger, match._danger = match._danger, match.danger()
+        r = match.rewards
+        reward = (r["survival"] * (w.t - self.t0) - r["hp"] * lost
+                  - r["capture"] * captures + danger - match._danger)
+        terminated = bool(w.done and captures and ends)
+        truncated = bool(w.done and not terminated)
+        return float(reward), terminated, truncated
+
+
 class Match:
     """One env's world, controllers, observation encoders, rewards and renderer.
 
@@ -184,7 +249,7 @@ class Match:
                  overrides: Mapping[str, Any], obs_radius: int = 2,
                  rewards: Mapping[str, float] | None = None,
                  render_mode: str | None = None,
-                 render_size: tuple[int, int] | None = None) -> None:
+                 render_size: tuple[int, int] | None = None, batched: bool = False) -> None:
         if abstraction not in ("grid", "partition"):
             raise ValueError(f"unknown abstraction {abstraction!r} (choose grid or partition)")
         if render_mode not in (None, "rgb_array", "human"):
@@ -199,11 +264,13 @@ class Match:
         if render_size is not None:
             render_size = _render_size(render_size)
         self.level = cached_level(level)
+        #: worlds for the batch engine (a vector env steps them): walls out of their spaces
+        self.batched = bool(batched)
         self.abstraction, self.scenario, self.guard_mode = abstraction, scenario, guard_mode
         self.overrides = dict(overrides)
         self.config = Config.load(self.overrides)
         self.graph = graph_for(self.level, abstraction)
-        self.moves = _direction_table(self.graph)
+        self.moves = direction_table(self.graph)
         self.n_actions = self.moves.shape[1]
         self.rewards = {**REWARDS, **(rewards or {})}
         self.render_mode, self.render_size = render_mode, render_size
@@ -247,7 +314,8 @@ class Match:
                          guards=self.guard_mode or "external", player="external",
                          scenario=self.scenario, seed=seed)
         return make_world(spec, self.config, level=self.level,
-                          controllers=(guard_ai, self.player), graph=self.graph)
+                          controllers=(guard_ai, self.player), graph=self.graph,
+                          walls_in_space=not self.batched)
 
     def reset(self, seed: int | None, fallback: np.random.Generator) -> dict[str, Any]:
         """Start the episode of trial seed ``seed`` (or the next one); return its info."""
@@ -307,45 +375,28 @@ class Match:
     def step(self, player_action: int, guard_actions: np.ndarray | None = None
              ) -> tuple[float, bool, bool]:
         """Play one player move; return (player reward, terminated, truncated)."""
+        move = self.begin_move(player_action, guard_actions)
         w = self.world
-        if w.done:
+        while True:
+            w.step()
+            if move.after_step(w.player.pos):
+                return move.result()
+
+    def begin_move(self, player_action: int, guard_actions: np.ndarray | None = None) -> Move:
+        """Ask for one player move (:class:`Move` says when it is over and what it earned);
+        the world is then stepped by the caller: this match (:meth:`step`) or a vector env
+        that steps many worlds at once."""
+        if self.world.done:
             raise RuntimeError("step() after the episode ended: call reset()")
         self.player.action, self.player.decisions = int(player_action), 0
         if self.guards is not None and guard_actions is not None:
             self.guards.actions[:] = guard_actions
-        hp0, t0, caps0 = w.hp, w.t, w.m.captures
-        staying = False
-        hp = hp0
-        for k in range(self.max_steps):
-            w.step()
-            if w.done or w.hp > hp:  # over, or respawned after a capture (fixed-time)
-                break
-            hp = w.hp
-            if self.player.decisions == 1 and k == 0:
-                staying = self.player.target == w.player.node and self._at(self.player.target)
-            if self.player.decisions:
-                if staying:
-                    if k + 1 >= self.hold_steps:
-                        break
-                elif self.player.decisions > 1 or self._at(self.player.target):
-                    break
-        captures = w.m.captures - caps0
-        ends = self.ends_on_capture
-        if captures and not ends:  # fixed-time: the player respawned with full HP
-            lost = hp0 + (captures - 1) * self.hp_max + (self.hp_max - w.hp)
-        else:
-            lost = hp0 - max(0.0, w.hp)
-        danger, self._danger = self._danger, self.danger()
-        reward = (self.rewards["survival"] * (w.t - t0) - self.rewards["hp"] * lost
-                  - self.rewards["capture"] * captures + danger - self._danger)
-        terminated = bool(w.done and captures and ends)
-        truncated = bool(w.done and not terminated)
-        return float(reward), terminated, truncated
+        return Move(self)
 
-    def _at(self, node: int) -> bool:
-        x, y = self.world.player.pos
+    def at(self, node: int, pos: tuple[float, float]) -> bool:
+        """Whether a player standing at ``pos`` is on ``node``'s point (within 1e-3)."""
         px, py = self._points[node]
-        return math.hypot(x - px, y - py) <= 1e-3
+        return math.hypot(pos[0] - px, pos[1] - py) <= 1e-3
 
     # ------------------------------------------------------------------ rendering
     def observe_player(self) -> np.ndarray:

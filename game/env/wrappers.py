@@ -27,9 +27,9 @@ import gymnasium
 import numpy as np
 from gymnasium import spaces
 
-from .observations import OBS_BOUND
+from .observations import OBS_BOUND, PLAYER_CHANNELS, Observer
 
-__all__ = ["OBSERVATIONS", "FlatObsWrapper", "ImgObsWrapper", "Layout"]
+__all__ = ["OBSERVATIONS", "FlatObsWrapper", "ImgObsWrapper", "Layout", "player_layout"]
 
 #: The observation kinds ``StealthEnv(observation=...)`` takes; the first is the default.
 OBSERVATIONS = ("flat", "dict", "image")
@@ -67,6 +67,13 @@ class Layout:
         if kind == "dict":
             return {"image": self.image(flat), "features": flat[self.window:].copy()}
         return flat
+
+
+def player_layout(observer: Observer) -> Layout:
+    """The layout of the player's observations made by ``observer``."""
+    side = 2 * observer.radius + 1
+    window = len(PLAYER_CHANNELS) * side * side
+    return Layout(len(PLAYER_CHANNELS), side, observer.obs_size(False) - window)
 
 
 def _dict_space(env: gymnasium.Env) -> spaces.Dict:
