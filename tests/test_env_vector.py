@@ -146,3 +146,30 @@ def test_wrong_actions_and_calls_are_refused_naming_them() -> None:
     with pytest.raises(ValueError, match="does not render"):
         StealthVectorEnv(2, level="maze", render_mode="rgb_array")
     assert vec.action_masks().shape == (2, 5)
+
+
+def test_same_step_autoreset_starts_the_next_episode_in_the_step_that_ended_one() -> None:
+    # Gymnasium's SAME_STEP (what SB3's VecEnv expects): the last observation and info of
+    # the ended episode in info["final_obs"] / info["final_info"], the next one's first
+    # observation in its place
+    options = {"level": "maze", "world__duration": 2.0}
+    vec = StealthVectorEnv(3, autoreset_mode="SameStep", **options)
+    assert vec.metadata["autoreset_mode"] is AutoresetMode.SAME_STEP
+    reference = StealthVectorEnv(3, **options)
+    vec.reset(seed=10)
+    reference.reset(seed=10)
+    ones = np.ones(3, dtype=np.int64)
+    while True:
+        obs, rewards, terminated, truncated, info = vec.step(ones)
+        last, expected, *_ = reference.step(ones)
+        assert np.array_equal(rewards, expected)
+        if (terminated | truncated).any():
+            break
+        assert np.array_equal(obs, last)
+    for i in np.flatnonzero(terminated | truncated):
+        assert np.array_equal(info["final_obs"][i], last[i])
+        assert info["final_info"]["t"][i] == 2.0 and info["t"][i] == 0.0
+        assert info["seed"][i] == 13 + i and np.array_equal(
+            obs[i], StealthEnv(**options).reset(seed=int(13 + i))[0])
+    with pytest.raises(ValueError, match="autoreset_mode must be"):
+        StealthVectorEnv(2, level="maze", autoreset_mode="Disabled")

@@ -39,6 +39,13 @@ from .wrappers import OBSERVATIONS, player_layout
 
 __all__ = ["MAX_NUM_ENVS", "StealthVectorEnv"]
 
+
+def _row(obs: Any, i: int) -> Any:
+    """Sub-env ``i``'s observation (a copy) out of a batch of them."""
+    if isinstance(obs, dict):
+        return {key: value[i].copy() for key, value in obs.items()}
+    return obs[i].copy()
+
 #: The most sub-envs one :class:`StealthVectorEnv` holds (10^9 ran out of memory after
 #: 38 s); more belong in several processes.
 MAX_NUM_ENVS = 1024
@@ -60,7 +67,9 @@ class StealthVectorEnv(gymnasium.vector.VectorEnv):
     def __init__(self, num_envs: int = 1, max_episode_steps: int | None = None,
                  level: str = "miami", guards: str = DEFAULT_GUARD_MODE,
                  abstraction: str = "grid", scenario: str = "capture",
-                 observation: str = "flat", **config: Any) -> None:
+                 observation: str = "flat",
+                 autoreset_mode: AutoresetMode | str = AutoresetMode.NEXT_STEP,
+                 **config: Any) -> None:
         if isinstance(num_envs, bool) or not isinstance(num_envs, (int, np.integer)) \
                 or not 1 <= num_envs <= MAX_NUM_ENVS:
             raise ValueError(f"num_envs must be a whole number in [1, {MAX_NUM_ENVS}], "
@@ -70,6 +79,13 @@ class StealthVectorEnv(gymnasium.vector.VectorEnv):
                                   or not (limit == -1 or limit >= 1)):
             raise ValueError(f"max_episode_steps must be a whole number >= 1 (or -1 or None: "
                              f"no limit), not {limit!r}")
+        modes = (AutoresetMode.NEXT_STEP, AutoresetMode.SAME_STEP)
+        mode = next((m for m in modes if autoreset_mode in (m, m.value)), None)
+        if mode is None:
+            raise ValueError(f"autoreset_mode must be {' or '.join(m.value for m in modes)}, "
+                             f"not {autoreset_mode!r}")
+        #: this env's own copy: NEXT_STEP (the class's) or SAME_STEP
+        self.metadata = {**self.metadata, "autoreset_mode": mode}
         if observation not in OBSERVATIONS:
             raise ValueError(f"unknown observation {observation!r} "
                              f"(choose from {', '.join(OBSERVATIONS)})")
@@ -194,7 +210,18 @@ class StealthVectorEnv(gymnasium.vector.VectorEnv):
                 truncated[i] = True  # TimeLimit's rule: cut at the limit, ended or not
             self._observe(i)
             infos = self._add_info(infos, self.matches[i].info(), i)
-        self._autoreset = terminated | truncated
+        ended = terminated | truncated
+        if self.metadata["autoreset_mode"] is AutoresetMode.SAME_STEP and ended.any():
+            # Gymnasium's SAME_STEP: the next episode starts now; the last observation and
+            # info of the ended one in info["final_obs"] / info["final_info"]
+            final = {i: (_row(self._obs, i), {k: v[i] for k, v in infos.items()
+                                               if not k.startswith("_") and infos["_" + k][i]})
+                     for i in np.flatnonzero(ended).tolist()}
+            for i, (last_obs, last_info) in final.items():
+                infos = self._add_info(infos, self._reset_one(i, int(self._seeds[i]) + n), i)
+                infos = self._add_info(infos, {"final_obs": last_obs, "final_info": last_info}, i)
+        else:
+            self._autoreset = ended
         return self._observations(), rewards, terminated, truncated, infos
 
     def _play(self, moves: dict[int, Move]) -> None:
