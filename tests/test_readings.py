@@ -283,3 +283,19 @@ def test_both_engines_give_the_readings_alike(abstraction: str) -> None:
     for key, metrics, *_ in batch:
         for name in ("coverage_area", "coverage_seen_area", "coverage_seen_per_guard"):
             assert metrics[name] is not None, (key, name)
+
+
+def test_the_study_of_the_readings_loads_and_runs_on_the_batch_engine() -> None:
+    # headless/studies/paper-infer.toml: the design of the later stage (not run here)
+    from game.batch import uncovered
+    from headless.tune.spec import load_tune_spec
+
+    spec = load_tune_spec("headless/studies/paper-infer.toml")
+    searched = {p.key: p for p in spec.params}
+    assert {"staleness.model", "player.safetygraph_goal", "player.safetygraph_hops",
+            "metrics.coverage", "metrics.partition_coverage", "world.guards"} <= set(searched)
+    assert searched["player.maxmin_depth"].low == 2  # l. 247: "several steps ahead"
+    assert (spec.seeds_train, spec.seeds_test) == (2, 48)  # held out: seeds 2-49
+    widest = {**dict(spec.preset.overrides), "world.guards": 6, "staleness.model": "alenezi",
+              "player.safetygraph_goal": "local"}
+    assert uncovered(TrialSpec("tlou", "partition"), Config.load(widest)) is None
