@@ -9,7 +9,6 @@ the shortest path by :func:`~ai.view.move_horizon` (one cell on the grid).
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
-import weakref
 from dataclasses import dataclass
 from typing import Any, ClassVar
 
@@ -315,8 +314,9 @@ class StalenessGuards(ScriptedGuards):
       staleness normalised over all nodes (their ``CalculateHeatValues``; 0 when all are
       equal), ``d`` the path distance from the guard, ``d_sep`` the path distance to the
       nearest other active guard (1·L when there is none or it is unreachable), ``L`` the
-      graph's longest shortest path (:func:`longest_shortest_path`). A node within 1 world
-      unit of another guard's target is taken (their ``IsGoalTaken``: squared distance ≤ 1).
+      graph's longest shortest path
+      (:meth:`~navmesh.graph.NodeGraph.longest_shortest_path`). A node within 1 world unit of
+      another guard's target is taken (their ``IsGoalTaken``: squared distance ≤ 1).
       The target is kept until the guard reaches it (their guard asks for a new goal only
       when it is not busy): no target is dropped for being seen. Ties (within 1e-9) are
       drawn with the generator (their loop keeps the first node of its list).
@@ -390,7 +390,7 @@ class StalenessGuards(ScriptedGuards):
         s = self.staleness
         lo, hi = float(s.min()), float(s.max())
         stale = (s - lo) / (hi - lo) if hi > lo else np.zeros(graph.n)
-        longest = longest_shortest_path(graph)
+        longest = graph.longest_shortest_path()
         distance = graph.dist_from(node)
         others = [int(v) for j, v in enumerate(self._guard_nodes if self._guard_nodes is not None
                                                else ())
@@ -436,37 +436,6 @@ class StalenessGuards(ScriptedGuards):
 #: taken (GridPatrolerDecisionMaker.IsGoalTaken: ``minSqrMagThreshold = 1``)
 ALENEZI_TAKEN_RADIUS = 1.0
 
-#: per graph: its longest shortest path (graphs are cached and shared by trials)
-_LONGEST: weakref.WeakKeyDictionary[NodeGraph, float] = weakref.WeakKeyDictionary()
-
-
-def longest_shortest_path(graph: NodeGraph) -> float:
-    """The longest finite shortest-path distance between two nodes of ``graph`` (their
-    ``PathFinding.longestShortestPath``), at least 1e-9. Exact on a graph that keeps its
-    distances dense (read from the matrix); on a larger one the double sweep's value (the
-    farthest node from the farthest node of node 0: a lower bound, exact on trees), so no
-    all-pairs search is run. Cached per graph.
-
-    >>> g = NodeGraph.from_grid(np.ones((2, 4), bool), 1.0)
-    >>> longest_shortest_path(g)
-    4.0
-    """
-    found = _LONGEST.get(graph)
-    if found is None:
-        if graph.n == 0:
-            found = 1e-9
-        elif graph.dense:
-            rows = graph.dist_from(np.arange(graph.n))
-            found = float(rows[np.isfinite(rows)].max())
-        else:
-            first = graph.dist_from(0)
-            far = int(np.argmax(np.where(np.isfinite(first), first, -1.0)))
-            second = graph.dist_from(far)
-            found = float(second[np.isfinite(second)].max())
-        found = _LONGEST[graph] = max(found, 1e-9)
-    return found
-
-
 def _information_depth(strength: float, falloff: float, threshold: float) -> int | None:
     """The largest hop count d with ``strength × falloff^d ≥ threshold`` (None: any depth).
 
@@ -492,5 +461,4 @@ __all__ = [
     "StalenessGuards",
     "ScriptedGuards",
     "GuardState",
-    "longest_shortest_path",
 ]

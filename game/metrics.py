@@ -11,7 +11,7 @@ module, no core file edited):
 ...                column="VisitedNodes", definition="nodes any guard entered")
 >>> _ = register_metric(extra)
 >>> [m.name for m in registered_metrics()][-2:]
-['dist_euclidean', 'visited_nodes']
+['coverage_seen_per_guard', 'visited_nodes']
 >>> unregister_metric("visited_nodes")
 >>> extra.sql_type, extra.table_columns()[0].name
 ('INTEGER', 'VisitedNodes')

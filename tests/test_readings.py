@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 
 from ai import make_player_policy
-from ai.baselines import StalenessGuards, longest_shortest_path
+from ai.baselines import StalenessGuards
 from ai.view import WorldView
 from game.batch import run_trials
 from game.config import Config
@@ -51,8 +51,8 @@ def test_the_longest_shortest_path_is_exact_dense_and_the_double_sweep_otherwise
     grid[1, 1:6] = False  # a ring: the double sweep from node 0 still finds the far corner
     dense = NodeGraph.from_grid(grid, 1.0, dense=True)
     searched = NodeGraph.from_grid(grid, 1.0, dense=False)
-    assert longest_shortest_path(dense) == 8.0  # corner to opposite corner, either way round
-    assert longest_shortest_path(searched) == 8.0
+    assert dense.longest_shortest_path() == 8.0  # corner to opposite corner, either way round
+    assert searched.longest_shortest_path() == 8.0
 
 
 def test_the_alenezi_score_is_their_weighted_sum_by_hand() -> None:
