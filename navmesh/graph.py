@@ -335,6 +335,17 @@ class NodeGraph:
             return np.inf
         return self.distances.nearest_to(nodes, int(target))
 
+    def components(self) -> np.ndarray:
+        """(n,) label of every node's connected piece."""
+        if self._labels is None:
+            _, self._labels = connected_components(self.adjacency, directed=False)
+        return self._labels
+
+    def reachable_from(self, node: int) -> np.ndarray:
+        """(n,) bool: the nodes connected to ``node`` (``isfinite(dist_from(node))``)."""
+        labels = self.components()
+        return labels == labels[int(node)]
+
     def longest_shortest_path(self) -> float:
         """The longest finite shortest-path distance between two nodes (at least 1e-9; Al Enezi
         & Verbrugge's ``longestShortestPath``, ``staleness.model = "alenezi"``). Exact on a
@@ -358,17 +369,6 @@ class NodeGraph:
                 found = float(second[np.isfinite(second)].max())
             self._longest = max(found, 1e-9)
         return self._longest
-
-    def components(self) -> np.ndarray:
-        """(n,) label of every node's connected piece."""
-        if self._labels is None:
-            _, self._labels = connected_components(self.adjacency, directed=False)
-        return self._labels
-
-    def reachable_from(self, node: int) -> np.ndarray:
-        """(n,) bool: the nodes connected to ``node`` (``isfinite(dist_from(node))``)."""
-        labels = self.components()
-        return labels == labels[int(node)]
 
     # ------------------------------------------------------------------ paths
     def shortest_path(self, a: int, b: int) -> list[int]:
