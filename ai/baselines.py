@@ -305,6 +305,21 @@ class StalenessGuards(ScriptedGuards):
       nodes farther than ``spread_radius`` from every other guard's target (ties drawn with
       the generator), and a target that any guard sees is done: the guard picks the next
       at its next decision.
+    * ``model = "alenezi"`` (SPEC §12): Al Enezi & Verbrugge's grid patroller as their
+      simulator's code scores it (wralenezi/Stealth-Simulator,
+      ``Assets/Resources/Scripts/NPCs/NPCBehaviors/Guards/Patroler/Gridbased/``
+      ``GridPatroler.cs`` and ``GridPatrolerDecisionMaker.cs``). Staleness is reset as in
+      ``view``; a target maximises ``staleness_weight × s̃ + distance_weight × (1 − d/L) +
+      separation_weight × d_sep/L``, where ``s̃ = (s − min s) / (max s − min s)`` is the
+      staleness normalised over all nodes (their ``CalculateHeatValues``; 0 when all are
+      equal), ``d`` the path distance from the guard, ``d_sep`` the path distance to the
+      nearest other active guard (1·L when there is none or it is unreachable), ``L`` the
+      graph's longest shortest path
+      (:meth:`~navmesh.graph.NodeGraph.longest_shortest_path`). A node within 1 world unit of
+      another guard's target is taken (their ``IsGoalTaken``: squared distance ≤ 1).
+      The target is kept until the guard reaches it (their guard asks for a new goal only
+      when it is not busy): no target is dropped for being seen. Ties (within 1e-9) are
+      drawn with the generator (their loop keeps the first node of its list).
     """
 
     mode = "staleness"
@@ -313,11 +328,21 @@ class StalenessGuards(ScriptedGuards):
     def reset(self, graph: NodeGraph, rng: np.random.Generator, n_guards: int) -> None:
         super().reset(graph, rng, n_guards)
         self.staleness = np.zeros(graph.n)
-        self.by_view = self.config.model == "view"  # type: ignore[attr-defined]
+        model = self.config.model  # type: ignore[attr-defined]
+        self.by_view = model in ("view", "alenezi")
+        #: view: a target in sight is done; alenezi keeps it until the guard is there
+        self.drops_seen = model == "view"
+        self._guard_nodes: np.ndarray | None = None
+        self._guard_active: np.ndarray | None = None
 
     def wants_guard_sight(self) -> bool:
-        """The view model resets staleness on what the guards see."""
-        return self.config.model == "view"  # type: ignore[attr-defined]
+        """The view and alenezi models reset staleness on what the guards see."""
+        return self.config.model in ("view", "alenezi")  # type: ignore[attr-defined]
+
+    def decide(self, i: int, view: WorldView) -> int:
+        """The FSM's decision; alenezi's patrol target reads where the other guards are."""
+        self._guard_nodes, self._guard_active = view.guard_nodes, view.guard_active
+        return super().decide(i, view)
 
     def tick(self, view: WorldView, dt: float) -> None:
         """Staleness grows by ``increment × dt`` and resets under (view: in sight of) the
@@ -328,8 +353,8 @@ class StalenessGuards(ScriptedGuards):
             sights = [s for s in view.guard_sight if len(s)]
             if sights:
                 self.staleness[np.concatenate(sights)] = 0.0
-            for gs in self.guards:  # a target in sight has been looked at: pick the next
-                if gs.target is not None and self.staleness[gs.target] == 0.0:
+            for gs in self.guards if self.drops_seen else ():  # a target in sight has been
+                if gs.target is not None and self.staleness[gs.target] == 0.0:  # looked at
                     gs.target = None
         super().tick(view, dt)
 
@@ -338,6 +363,8 @@ class StalenessGuards(ScriptedGuards):
 
     def _patrol_target(self, i: int, node: int) -> int:
         taken = self._taken_targets(i)
+        if self.config.model == "alenezi":  # type: ignore[attr-defined]
+            return self._alenezi_target(i, node, taken)
         if not self.by_view:
             values = np.where(self.graph.reachable_from(node), self.staleness, -np.inf)
         else:
@@ -355,6 +382,42 @@ class StalenessGuards(ScriptedGuards):
         stalest = np.flatnonzero(values >= best - 1e-9)
         return int(stalest[self.rng.integers(len(stalest))])
 
+    def alenezi_scores(self, i: int, node: int) -> np.ndarray:
+        """Per node, guard ``i``'s alenezi score from ``node`` (see the class; ``-inf`` where
+        unreachable). Their ``GetWeightedSumFittestTarget`` term by term."""
+        c = self.config
+        graph = self.graph
+        s = self.staleness
+        lo, hi = float(s.min()), float(s.max())
+        stale = (s - lo) / (hi - lo) if hi > lo else np.zeros(graph.n)
+        longest = graph.longest_shortest_path()
+        distance = graph.dist_from(node)
+        others = [int(v) for j, v in enumerate(self._guard_nodes if self._guard_nodes is not None
+                                               else ())
+                  if j != i and (self._guard_active is None or self._guard_active[j])]
+        separation = np.ones(graph.n)
+        if others:
+            nearest = graph.nearest_dist(others) / longest
+            separation = np.where(np.isfinite(nearest), nearest, 1.0)
+        score = (c.staleness_weight * stale  # type: ignore[attr-defined]
+                 + c.distance_weight * (1.0 - distance / longest)  # type: ignore[attr-defined]
+                 + c.separation_weight * separation)  # type: ignore[attr-defined]
+        return np.where(np.isfinite(distance), score, -np.inf)
+
+    def _alenezi_target(self, i: int, node: int, taken: list[int]) -> int:
+        values = self.alenezi_scores(i, node)
+        values[node] = -np.inf
+        if taken:  # IsGoalTaken: within 1 unit (squared distance <= 1) of another's goal
+            pos = self.graph.positions
+            for t in taken:
+                d = pos - pos[t]
+                values[d[:, 0] * d[:, 0] + d[:, 1] * d[:, 1] <= ALENEZI_TAKEN_RADIUS ** 2] = -np.inf
+        best = values.max()
+        if not np.isfinite(best):
+            return node
+        fittest = np.flatnonzero(values >= best - 1e-9)
+        return int(fittest[self.rng.integers(len(fittest))])
+
     def _spread(self, values: np.ndarray, taken: list[int], radius: float) -> np.ndarray:
         """``values`` with the nodes within ``radius`` of another guard's target ruled out,
         unless that rules out everything (a small level, many guards)."""
@@ -368,6 +431,10 @@ class StalenessGuards(ScriptedGuards):
         spread = np.where(near, -np.inf, values)
         return spread if np.isfinite(spread).any() else values
 
+
+#: ``staleness.model = "alenezi"``: a goal this close (world units) to another guard's goal is
+#: taken (GridPatrolerDecisionMaker.IsGoalTaken: ``minSqrMagThreshold = 1``)
+ALENEZI_TAKEN_RADIUS = 1.0
 
 def _information_depth(strength: float, falloff: float, threshold: float) -> int | None:
     """The largest hop count d with ``strength × falloff^d ≥ threshold`` (None: any depth).

@@ -166,9 +166,14 @@ class PFParams(Params):
 INVESTIGATE_RULES = ("team", "local")
 """``fsm.investigate`` / ``staleness.investigate`` (first: the rule before SPEC §11)."""
 
-STALENESS_MODELS = ("node", "view")
+STALENESS_MODELS = ("node", "view", "alenezi")
 """``staleness.model``: ``node`` resets staleness only where a guard stands; ``view`` on every
-node a guard sees (Al Enezi & Verbrugge 2020; docs/ai.md)."""
+node a guard sees (Al Enezi & Verbrugge 2020; docs/ai.md); ``alenezi`` resets as ``view`` and
+scores targets as their simulator's code does (SPEC §12; ai/baselines.py, docs/ai.md)."""
+
+SAFETYGRAPH_GOALS = ("escape", "paper", "local")
+"""``player.safetygraph_goal``: ours, the paper's text only, and the paper's text with the goal
+sought within ``safetygraph_hops`` hops (SPEC §12; ai/players.py)."""
 
 
 @dataclass(frozen=True)
@@ -215,10 +220,16 @@ class StalenessParams(FSMParams):
     distance_weight: float = 0.5
     #: view: no target within this distance (world units) of another guard's target
     spread_radius: float = 4.0
+    #: alenezi: weight of the normalised staleness (their ``StalenessWeight``; with
+    #: ``distance_weight`` on the closeness 1 − d/L and ``separation_weight`` on the distance
+    #: to the nearest other guard / L; their defaults 1, 0.5, 0.5)
+    staleness_weight: float = 1.0
+    separation_weight: float = 0.5
 
     bounds = {**FSMParams.bounds, "increment": NON_NEGATIVE,
               "model": OneOf(STALENESS_MODELS), "distance_weight": Range(0.0, 100.0),
-              "spread_radius": NON_NEGATIVE}
+              "spread_radius": NON_NEGATIVE, "staleness_weight": Range(0.0, 100.0),
+              "separation_weight": Range(0.0, 100.0)}
 
 
 @dataclass(frozen=True)
@@ -237,9 +248,12 @@ class PlayerParams(Params):
     r_edge_factor: float = 2.5  # partition step horizon of SafetyGraph
     tie_eps: float = 1e-9
     #: SafetyGraph's goal rule: "escape" (ours: the farthest node kept ``safety_margin`` safe,
-    #: re-planned at every decision) or "paper" (the paper's text only: the safest node, A*
-    #: with a Euclidean heuristic, margin 0, re-planned once per decision tick); ai/players.py
+    #: re-planned at every decision), "paper" (the paper's text only: the safest node, A*
+    #: with a Euclidean heuristic, margin 0, re-planned once per decision tick) or "local"
+    #: ("paper" with the safest node within ``safetygraph_hops`` hops); ai/players.py
     safetygraph_goal: str = "escape"
+    #: SafetyGraph ``local``: the goal is the node of greatest S within this many hops
+    safetygraph_hops: int = 3
 
     from_world = ("guard_speed", "player_speed")
     bounds = {
@@ -251,9 +265,10 @@ class PlayerParams(Params):
         "safety_penalty": NON_NEGATIVE,
         "r_edge_factor": POSITIVE,
         "tie_eps": NON_NEGATIVE,
-        "safetygraph_goal": OneOf(("escape", "paper")),
+        "safetygraph_goal": OneOf(SAFETYGRAPH_GOALS),
+        "safetygraph_hops": Range(1, 1000, integer=True),
     }
 
 
 __all__ = ["Params", "PFParams", "FSMParams", "StalenessParams", "PlayerParams", "INVESTIGATE_RULES",
-           "STALENESS_MODELS"]
+           "SAFETYGRAPH_GOALS", "STALENESS_MODELS"]

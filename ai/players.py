@@ -170,6 +170,8 @@ class SafetyGraphPlayer(PlayerPolicy):
     far-side rule, margin 0), the path an A* search with the straight-line heuristic and
     edge costs ``length × (1 + safety_penalty × max(0, −S(head)))`` (:meth:`astar`), planned
     once per decision tick (``WorldView.decision_tick``) and followed between ticks.
+    ``safetygraph_goal = "local"`` is that, with the goal the node of greatest S within
+    ``safetygraph_hops`` hops of the player (:meth:`local_goal`; SPEC §12).
     """
 
     policy = "safetygraph"
@@ -203,7 +205,7 @@ class SafetyGraphPlayer(PlayerPolicy):
         guards = active_guard_nodes(view)
         if len(guards) == 0:
             return node
-        if self.config.safetygraph_goal == "paper":
+        if self.config.safetygraph_goal in ("paper", "local"):
             return self._decide_paper(view, node, guards)
         safety, guard_time = self.safety(node, guards)
         goal = self.choose_goal(node, safety, guard_time)
@@ -265,7 +267,8 @@ class SafetyGraphPlayer(PlayerPolicy):
         early only when it is off the plan, e.g. a stuck body re-routed)."""
         if view.decision_tick != self.plan_tick or node not in self.plan:
             safety, _ = self.safety(node, guards)
-            goal = self.paper_goal(node, safety)
+            goal = (self.local_goal(node, safety) if self.config.safetygraph_goal == "local"
+                    else self.paper_goal(node, safety))
             self.last_safety, self.last_goal = safety, goal
             self.plan, self.plan_tick = self.astar(node, goal, safety), view.decision_tick
         path = self.plan[self.plan.index(node):]
@@ -282,6 +285,15 @@ class SafetyGraphPlayer(PlayerPolicy):
         reachable = self.graph.reachable_from(node) & ~np.isnan(safety)
         score = np.where(reachable, safety, -np.inf)
         goals = np.flatnonzero(score >= score.max() - self.config.tie_eps)  # inf: unguarded
+        return int(goals[0] if len(goals) == 1 else goals[self.rng.integers(len(goals))])
+
+    def local_goal(self, node: int, safety: np.ndarray) -> int:
+        """``safetygraph_goal = "local"``: :meth:`paper_goal` among the nodes within
+        ``safetygraph_hops`` hops of the player (its own node included; ties within
+        ``tie_eps``: the generator)."""
+        inside, _ = self.graph.hop_ball(node, self.config.safetygraph_hops)
+        score = np.where(np.isnan(safety[inside]), -np.inf, safety[inside])
+        goals = inside[score >= score.max() - self.config.tie_eps]
         return int(goals[0] if len(goals) == 1 else goals[self.rng.integers(len(goals))])
 
     def astar(self, node: int, goal: int, safety: np.ndarray) -> list[int]:

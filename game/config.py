@@ -48,7 +48,13 @@ IDENTITY_NEUTRAL: frozenset[str] = frozenset({ENGINE_KEY})
 #: :meth:`Config.hash` while at their default, so those stores keep their hash and resume
 NEUTRAL_AT_DEFAULT: frozenset[str] = frozenset({"world.attack_needs_awareness",
                                                 "world.attack_memory", "world.sneak_factor",
-                                                "awareness.gait_sneak"})
+                                                "awareness.gait_sneak",
+                                                # SPEC §12's readings (their keys read only
+                                                # under staleness.model = "alenezi" /
+                                                # player.safetygraph_goal = "local")
+                                                "staleness.staleness_weight",
+                                                "staleness.separation_weight",
+                                                "player.safetygraph_hops"})
 
 #: the table of ``stealth play``'s own defaults (:func:`play_defaults`), no section of keys
 PLAY_TABLE = "play"

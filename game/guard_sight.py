@@ -240,6 +240,13 @@ class ViewCover(_NodeView):
         _compiled().cover(self._seen, self._blocker, gx, gy, gcos, gsin, self.bound, self.limit,
                self.cos_half_fov, *self.index.arrays, *self.walls.arrays)
 
+    def fresh(self) -> ViewCover:
+        """A cover of the same graph, sight and walls that has seen nothing yet (one per
+        guard: ``metrics.coverage = "seen_per_guard"``)."""
+        cover = ViewCover(self.graph, self.senses, self.reach, self._wall_ends)
+        cover._walls = self._walls
+        return cover
+
     def share(self) -> float:
         """The share of nodes seen so far (0 on an empty graph)."""
         seen = self.seen

@@ -11,7 +11,7 @@ module, no core file edited):
 ...                column="VisitedNodes", definition="nodes any guard entered")
 >>> _ = register_metric(extra)
 >>> [m.name for m in registered_metrics()][-2:]
-['dist_euclidean', 'visited_nodes']
+['coverage_seen_per_guard', 'visited_nodes']
 >>> unregister_metric("visited_nodes")
 >>> extra.sql_type, extra.table_columns()[0].name
 ('INTEGER', 'VisitedNodes')
@@ -21,7 +21,7 @@ from __future__ import annotations
 
 import math
 from collections import deque
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any, Protocol
 
@@ -34,7 +34,7 @@ if TYPE_CHECKING:
     from .guard_sight import ViewCover
 
 __all__ = ["AGGREGATES", "BACKTRACK_RULES", "COVERAGE_RULES", "Counters", "DISTANCE_RULES",
-           "Measured", "Metric", "RECENT_ENTRIES", "TableColumn", "register_metric", "registered_metrics",
+           "Measured", "PARTITION_COVERAGE_RULES", "coverage_rule", "node_areas", "Metric", "RECENT_ENTRIES", "TableColumn", "register_metric", "registered_metrics",
            "metric_names", "unregister_metric", "world_metrics"]
 
 #: how a metric's per-trial values become one Table 3 cell: ``mean`` of the values, or
@@ -46,7 +46,10 @@ _SQL_TYPES = {"bool": "INTEGER", "int": "INTEGER", "float": "REAL"}
 #: within the last N = 5 steps)" (guard-ai-composite-potential-fields.tex, line 328)
 RECENT_ENTRIES = 5
 #: the values of the ``[metrics]`` keys (SPEC §11), today's definition first (the default)
-COVERAGE_RULES = ("visited", "seen", "per_guard")
+COVERAGE_RULES = ("visited", "seen", "per_guard", "area", "seen_area", "seen_per_guard")
+#: ``metrics.partition_coverage`` (SPEC §12): the partition's own coverage reading, or
+#: ``same`` (the default): the one ``metrics.coverage`` names for both abstractions
+PARTITION_COVERAGE_RULES = ("same", *COVERAGE_RULES)
 BACKTRACK_RULES = ("targets", "entries")
 DISTANCE_RULES = ("path", "euclidean")
 
@@ -71,6 +74,9 @@ class Counters:
     recent_entries: list[deque[int]] = field(default_factory=list)
     #: the nodes inside a guard's view at some AI tick (set by the world)
     view_cover: ViewCover | None = None
+    #: per guard, the nodes inside that guard's view at some AI tick (made from
+    #: ``view_cover`` at the first tick)
+    guard_view_covers: list[ViewCover] = field(default_factory=list)
     #: per node: ever entered by a guard; guard entries; HP the player lost there
     covered: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=bool))
     visits: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=np.int64))
@@ -146,6 +152,12 @@ class Counters:
         """At an AI tick: the nodes the guards see now count for ``coverage_seen``."""
         if self.view_cover is not None:
             self.view_cover.observe(guards)
+            guards = list(guards)
+            covers = self.guard_view_covers
+            while len(covers) < len(guards):
+                covers.append(self.view_cover.fresh())
+            for cover, guard in zip(covers, guards):
+                cover.observe((guard,))
 
     def count_capture(self, t: float) -> None:
         """The player lost all HP at time ``t``."""
@@ -184,6 +196,13 @@ class Counters:
         number of guards)."""
         n = len(self.covered)
         return sum(int(c.sum()) for c in self.guard_covered) / n if n else 0.0
+
+    def seen_per_guard_coverage(self) -> float | None:
+        """The sum over guards of the share of nodes inside that guard's view at some AI tick
+        (up to the number of guards; None: not tracked)."""
+        if self.view_cover is None:
+            return None
+        return float(sum(cover.share() for cover in self.guard_view_covers))
 
     def seen_coverage(self) -> float | None:
         """The share of nodes inside some guard's view at an AI tick (None: not tracked)."""
@@ -302,11 +321,34 @@ def _visited(w: Measured) -> float:
     return float(w.m.covered.mean()) if w.graph.n else 0.0
 
 
+def node_areas(graph: NodeGraph) -> np.ndarray:
+    """(n,) the walkable area of each node: a partition's triangle areas, a grid's cell
+    area."""
+    if graph.mesh is not None:
+        return np.asarray(graph.mesh.areas, dtype=np.float64)
+    return np.full(graph.n, float(graph.cell_size) ** 2)
+
+
+def _area_share(graph: NodeGraph, nodes: np.ndarray) -> float:
+    """The share of the walkable area in the nodes where ``nodes`` (bool, (n,)) is true."""
+    areas = node_areas(graph)
+    total = float(areas.sum())
+    return float(areas[nodes].sum()) / total if total > 0 else 0.0
+
+
+def _seen_area(w: Measured) -> float | None:
+    cover = w.m.view_cover
+    return None if cover is None else _area_share(w.graph, cover.seen)
+
+
 #: every definition of the keyed metrics (SPEC §11), by the value of its ``metrics.*`` key
 _COVERAGE: dict[str, Callable[[Measured], float | None]] = {
     "visited": _visited,
     "seen": lambda w: w.m.seen_coverage(),
     "per_guard": lambda w: w.m.per_guard_coverage(),
+    "area": lambda w: _area_share(w.graph, w.m.covered),
+    "seen_area": _seen_area,
+    "seen_per_guard": lambda w: w.m.seen_per_guard_coverage(),
 }
 _BACKTRACKS: dict[str, Callable[[Measured], int]] = {
     "targets": lambda w: w.m.backtracks,
@@ -324,6 +366,26 @@ def _keyed(table: dict[str, Callable[[Measured], Any]], key: str) -> Callable[[M
     return lambda w: table[w.config.section("metrics").get(key, first)](w)
 
 
+def coverage_rule(rules: Mapping[str, Any], abstraction: str) -> str:
+    """The coverage reading of a trial on ``abstraction`` under the ``[metrics]`` keys
+    ``rules``: ``partition_coverage`` on the partition unless it is ``same``, else
+    ``coverage``.
+
+    >>> coverage_rule({"coverage": "seen", "partition_coverage": "area"}, "partition")
+    'area'
+    >>> coverage_rule({"coverage": "seen", "partition_coverage": "area"}, "grid")
+    'seen'
+    """
+    own = str(rules.get("partition_coverage", "same"))
+    if abstraction == "partition" and own != "same":
+        return own
+    return str(rules.get("coverage", COVERAGE_RULES[0]))
+
+
+def _coverage(w: Measured) -> float | None:
+    return _COVERAGE[coverage_rule(w.config.section("metrics"), w.graph.kind)](w)
+
+
 _CORE: tuple[Metric, ...] = (
     Metric("captured", lambda w: w.m.captures > 0, kind="bool", scenarios=("capture",),
            aggregate="rate", column="CaptureRate", unit="fraction",
@@ -335,10 +397,11 @@ _CORE: tuple[Metric, ...] = (
            "rate 0.04)"),
     Metric("captures", lambda w: w.m.captures, kind="int", column="CapturesInTime",
            definition="captures in 60 s (the player respawns after each)"),
-    Metric("coverage", _keyed(_COVERAGE, "coverage"),
+    Metric("coverage", _coverage,
            column="CoverageRate", unit="fraction",
            definition="by `metrics.coverage` (default `visited`: the fraction of walkable "
-           "nodes (cells or triangles) any guard entered, in [0, 1]); see coverage_*"),
+           "nodes (cells or triangles) any guard entered, in [0, 1]; on the partition "
+           "`metrics.partition_coverage` when it is not `same`); see coverage_*"),
     Metric("avg_guard_player_dist", _keyed(_DISTANCE, "distance"),
            column="AvgGuardPlayerDist", title="AvgGuard–PlayerDist", unit="world units",
            definition="by `metrics.distance` (default `path`: the mean over physics steps of "
@@ -372,6 +435,16 @@ _CORE: tuple[Metric, ...] = (
     Metric("dist_euclidean", _DISTANCE["euclidean"], unit="world units",
            definition="mean over physics steps of the straight-line distance from the "
            "player to the closest active guard"),
+    # SPEC §12's coverage readings (after the older columns, so the stores' order holds)
+    Metric("coverage_area", _COVERAGE["area"], unit="fraction",
+           definition="share of the walkable area in the nodes any guard's centre entered "
+           "(a partition's triangles by their area; on the grid equal to coverage_visited)"),
+    Metric("coverage_seen_area", _COVERAGE["seen_area"], unit="fraction",
+           definition="share of the walkable area in the nodes inside some active guard's "
+           "view at some AI tick"),
+    Metric("coverage_seen_per_guard", _COVERAGE["seen_per_guard"], unit="fraction",
+           definition="sum over guards of the fraction of nodes inside that guard's view at "
+           "some AI tick (up to the number of guards)"),
 )
 
 _REGISTRY: dict[str, Metric] = {m.name: m for m in _CORE}

@@ -42,7 +42,7 @@ from navmesh.level import ZONE_KINDS
 from .action_params import ActionParams
 from .budget import check_trial_steps
 from .errors import ConfigError
-from .metrics import BACKTRACK_RULES, COVERAGE_RULES, DISTANCE_RULES
+from .metrics import BACKTRACK_RULES, COVERAGE_RULES, DISTANCE_RULES, PARTITION_COVERAGE_RULES
 
 if TYPE_CHECKING:
     from navmesh.level import Level
@@ -124,6 +124,8 @@ SCENARIO: Mapping[str, Bound] = {
 # change what is measured, never what happens
 METRICS: Mapping[str, Bound] = {
     "coverage": OneOf(COVERAGE_RULES),
+    # SPEC §12: the partition's own reading ("same": metrics.coverage on both)
+    "partition_coverage": OneOf(PARTITION_COVERAGE_RULES),
     "backtracks": OneOf(BACKTRACK_RULES),
     "distance": OneOf(DISTANCE_RULES),
 }

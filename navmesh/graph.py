@@ -141,6 +141,7 @@ class NodeGraph:
         if self.dense is None:
             self.dense = keeps_dense(n)
         self._labels: np.ndarray | None = None
+        self._longest: float | None = None
         #: the storage strategy every distance query goes to (chosen here, once)
         self.distances: Distances = distances_for(self.adjacency, lambda: self._neighbour_table,
                                                   bool(self.dense))
@@ -350,6 +351,30 @@ class NodeGraph:
         """(n,) bool: the nodes connected to ``node`` (``isfinite(dist_from(node))``)."""
         labels = self.components()
         return labels == labels[int(node)]
+
+    def longest_shortest_path(self) -> float:
+        """The longest finite shortest-path distance between two nodes (at least 1e-9; Al Enezi
+        & Verbrugge's ``longestShortestPath``, ``staleness.model = "alenezi"``). Exact on a
+        graph that keeps its distances dense (read from the matrix); on a larger one the
+        double sweep's value (the farthest node from the farthest node of node 0: a lower
+        bound, exact on trees), so no all-pairs search runs. Cached.
+
+        >>> NodeGraph.from_grid(np.ones((2, 4), bool), 1.0).longest_shortest_path()
+        4.0
+        """
+        if self._longest is None:
+            if self.n == 0:
+                found = 0.0
+            elif self.dense:
+                rows = self.dist_from(np.arange(self.n))
+                found = float(rows[np.isfinite(rows)].max())
+            else:
+                first = self.dist_from(0)
+                far = int(np.argmax(np.where(np.isfinite(first), first, -1.0)))
+                second = self.dist_from(far)
+                found = float(second[np.isfinite(second)].max())
+            self._longest = max(found, 1e-9)
+        return self._longest
 
     # ------------------------------------------------------------------ paths
     def shortest_path(self, a: int, b: int) -> list[int]:

@@ -55,7 +55,10 @@ def test_the_config_hash_is_pinned() -> None:
     assert Config.load(["pf.rho=0.9"]).hash() == "6e28a1d79ad34ffd"
     assert Config.load(["metrics.coverage=seen", "awareness.enabled=true"]).hash() \
         == "53837f3c38328917"
-    assert len(Config.defaults().as_dict()) == 151  # world.engine (SPEC §12); play: attack_needs_awareness, attack_memory, sneak_factor, gait_sneak
+    # world.engine (SPEC §12); play: attack_needs_awareness, attack_memory, sneak_factor,
+    # gait_sneak; readings (SPEC §12): staleness_weight, separation_weight, safetygraph_hops,
+    # metrics.partition_coverage (all out of the hash at their default)
+    assert len(Config.defaults().as_dict()) == 155
     assert Config.load(["world.attack_needs_awareness=true"]).hash() != Config.defaults().hash()
     from headless.presets import load_preset
 

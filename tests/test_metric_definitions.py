@@ -244,9 +244,11 @@ def test_the_report_names_the_coverage_and_distance_definition_in_use(tmp_path: 
     from headless.analysis.readme import metric_rules
     from headless.analysis.tables import write_table
 
-    assert metric_rules({}) == {"coverage": "visited", "backtracks": "targets", "distance": "path"}
+    assert metric_rules({}) == {"coverage": "visited", "partition_coverage": "same",
+                                "backtracks": "targets", "distance": "path"}
     rules = metric_rules({"set": {"metrics.coverage": "per_guard", "metrics.distance": "euclidean"}})
-    assert rules == {"coverage": "per_guard", "backtracks": "targets", "distance": "euclidean"}
+    assert rules == {"coverage": "per_guard", "partition_coverage": "same",
+                     "backtracks": "targets", "distance": "euclidean"}
     write_table([], tmp_path, 0)
     assert "CoverageRate is a true fraction in [0, 1]" in (tmp_path / "table.md").read_text()
     write_table([], tmp_path, 0, "per_guard")

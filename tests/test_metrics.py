@@ -49,7 +49,9 @@ def test_core_registry_is_the_spec_metrics_in_order() -> None:
                               # SPEC §11: every definition of the keyed ones
                               "coverage_visited", "coverage_seen", "coverage_per_guard",
                               "backtracks_targets", "backtracks_entries", "dist_path",
-                              "dist_euclidean")
+                              "dist_euclidean",
+                              # SPEC §12: the coverage readings the paper's numbers may select
+                              "coverage_area", "coverage_seen_area", "coverage_seen_per_guard")
     with pytest.raises(ValueError, match="already registered"):
         register_metric(Metric("captures", lambda w: 0))
     with pytest.raises(ValueError, match="core metric"):

@@ -225,7 +225,8 @@ def test_agents_never_leave_the_walkable_area_at_60_hz(level_name: str, abstract
 # ---------------------------------------------------------------------- determinism
 #: SPEC §11: every definition of the keyed metrics, reported beside the SPEC §9 ones
 METRIC_DEFINITIONS = ("coverage_visited", "coverage_seen", "coverage_per_guard",
-                      "backtracks_targets", "backtracks_entries", "dist_path", "dist_euclidean")
+                      "backtracks_targets", "backtracks_entries", "dist_path", "dist_euclidean",
+                      "coverage_area", "coverage_seen_area", "coverage_seen_per_guard")
 
 
 @pytest.mark.parametrize("scenario", ["capture", "fixed"])

@@ -40,6 +40,14 @@ _COVERAGE = {
     "per_guard": "* **Coverage is summed over guards** (`metrics.coverage = per_guard`): each "
                  "guard's fraction of nodes entered, summed, so it can exceed 1 as the paper's "
                  "partition column does.",
+    "area": "* **Coverage is the fraction of the walkable area entered** (`metrics.coverage = "
+            "area`): nodes weighted by their area, in [0, 1].",
+    "seen_area": "* **Coverage is the fraction of the walkable area seen** (`metrics.coverage = "
+                 "seen_area`): nodes inside some guard's view at an AI tick, weighted by their "
+                 "area, in [0, 1].",
+    "seen_per_guard": "* **Coverage is summed over guards' views** (`metrics.coverage = "
+                      "seen_per_guard`): each guard's fraction of nodes it saw at an AI tick, "
+                      "summed, so it can exceed 1 as the paper's partition column does.",
 }
 #: the columns of every definition (game.metrics)
 _DEFINED = ("coverage_", "backtracks_", "dist_")
@@ -135,6 +143,10 @@ def readme(directory: Path, meta: Mapping[str, str], done: int, skipped_heat: in
         "## Where these numbers differ from the paper",
         "",
         _COVERAGE.get(rules["coverage"], _COVERAGE["visited"]),
+        *(() if rules.get("partition_coverage", "same") in ("same", rules["coverage"]) else (
+            "* **The partition has its own coverage reading** (`metrics.partition_coverage = "
+            f"{rules['partition_coverage']}`; the grid's is the line above), the column "
+            f"`coverage_{rules['partition_coverage']}` of trials.csv.",)),
         "* CaptureTime and FirstDetectTime are censored at the trial duration (see above), not "
         "averaged over the trials where the event happened.",
         _DISTANCE.get(rules["distance"], _DISTANCE["path"]),

@@ -102,7 +102,8 @@ def write_report(directory: str | Path, *, figures: bool = True,
     written.append(path)
 
     rows = table_rows(trials, design.get("abstractions"))
-    write_table(rows, directory, len(trials), metric_rules(design)["coverage"])
+    rules = metric_rules(design)
+    write_table(rows, directory, len(trials), rules["coverage"], rules["partition_coverage"])
     written += [directory / "table.md", directory / "table.csv"]
 
     failed_path = directory / "failed.csv"

@@ -159,13 +159,32 @@ COVERAGE_NOTES = {
     "per_guard": "CoverageRate is each guard's fraction of nodes entered, summed over the "
                  "guards (`metrics.coverage = per_guard`), so it can exceed 1 as the paper's "
                  "partition coverage does.",
+    "area": "CoverageRate is the fraction of the walkable area in the nodes a guard entered "
+            "(`metrics.coverage = area`), in [0, 1].",
+    "seen_area": "CoverageRate is the fraction of the walkable area in the nodes inside some "
+                 "guard's view at an AI tick (`metrics.coverage = seen_area`), in [0, 1].",
+    "seen_per_guard": "CoverageRate is each guard's fraction of nodes inside its own view at "
+                      "an AI tick, summed over the guards (`metrics.coverage = "
+                      "seen_per_guard`), so it can exceed 1 as the paper's partition coverage "
+                      "does.",
 }
 
 
+def coverage_note(coverage: str, partition_coverage: str = "same") -> str:
+    """What table.md says of CoverageRate under the ``[metrics]`` keys (SPEC §11, §12)."""
+    note = COVERAGE_NOTES.get(coverage, COVERAGE_NOTES["visited"])
+    if partition_coverage in ("same", coverage):
+        return note
+    own = COVERAGE_NOTES.get(partition_coverage, COVERAGE_NOTES["visited"])
+    return (f"On the grid: {note} On the partition (`metrics.partition_coverage = "
+            f"{partition_coverage}`): {own}")
+
+
 def write_table(rows: Sequence[Mapping[str, Any]], directory: Path, trials_total: int,
-                coverage: str = "visited") -> None:
+                coverage: str = "visited", partition_coverage: str = "same") -> None:
     """``table.csv`` (every number) and ``table.md`` (the paper's layout) from :func:`table_rows`;
-    ``coverage``: the trials' ``metrics.coverage``, which the table's note names."""
+    ``coverage``, ``partition_coverage``: the trials' ``metrics.*`` keys, which the table's
+    note names."""
     columns = table_columns()
     with (directory / "table.csv").open("w", newline="", encoding="utf-8") as handle:
         writer = csv.writer(handle)
@@ -189,7 +208,7 @@ def write_table(rows: Sequence[Mapping[str, Any]], directory: Path, trials_total
         "from capture-scenario trials, the other columns from fixed-time trials. CaptureTime "
         "counts an uncaptured trial as its full duration (60 s by default) and FirstDetectTime "
         "a trial without a detection likewise, as the paper's numbers do. "
-        + COVERAGE_NOTES.get(coverage, COVERAGE_NOTES["visited"]) + " See README.md.",
+        + coverage_note(coverage, partition_coverage) + " See README.md.",
         "",
     ]
     titles = [m.heading for m in columns]
