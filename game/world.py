@@ -204,14 +204,24 @@ class World(PlayerActions):
 
     def view(self) -> WorldView:
         """The snapshot the controllers read."""
+        guards = self.guards
+        return self.view_of(
+            np.array([g.node for g in guards], dtype=np.int64),
+            np.array([g.pos for g in guards], dtype=np.float64),
+            np.array([g.heading for g in guards], dtype=np.float64),
+            np.array([g.active for g in guards], dtype=bool),
+            self.player.node, np.array(self.player.pos))
+
+    def view_of(self, guard_nodes: np.ndarray, guard_positions: np.ndarray,
+                guard_headings: np.ndarray, guard_active: np.ndarray, player_node: int,
+                player_pos: np.ndarray) -> WorldView:
+        """:meth:`view` with the agents' state given (the batch engine has it in arrays):
+        the rest of the snapshot is the world's."""
         return WorldView(
-            t=self.t, graph=self.graph,
-            guard_nodes=np.array([g.node for g in self.guards], dtype=np.int64),
-            guard_positions=np.array([g.pos for g in self.guards], dtype=np.float64),
-            guard_headings=np.array([g.heading for g in self.guards], dtype=np.float64),
-            player_node=self.player.node, player_pos=np.array(self.player.pos),
+            t=self.t, graph=self.graph, guard_nodes=guard_nodes, guard_positions=guard_positions,
+            guard_headings=guard_headings, player_node=player_node, player_pos=player_pos,
             seen_by=self.seen_by, sighting=self.sighting, events=tuple(self.tick_events),
-            zones=self.zones, guard_active=np.array([g.active for g in self.guards], dtype=bool),
+            zones=self.zones, guard_active=guard_active,
             decision_tick=self.step_index // self.steps_per_plan,
         )
 
@@ -240,10 +250,10 @@ class World(PlayerActions):
         self._sense()
         self.end_step()
 
-    def decide(self) -> None:
-        """A decision tick: every active guard and the player without a plan decide."""
+    def decide(self, view: WorldView | None = None) -> None:
+        """A decision tick: every active guard and the player without a plan decide
+        (reading ``view``, or the world's :meth:`view` made when first needed)."""
         walk = self.locomotion
-        view = None
         for i, guard in enumerate(self.guards):
             if guard.active and guard.needs_decision:
                 view = view or self.view()

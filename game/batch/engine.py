@@ -252,10 +252,12 @@ class Batch:
             world.decide()
             self.push(b)
             return
-        self.pull_view(b)
-        for a in askers:
+        for a in askers:  # a plan starts where the agent stands
             self.pull(b, a)
-        world.decide()
+        p = self.pos.shape[1] - 1
+        world.decide(world.view_of(self.node[b, :p].copy(), self.pos[b, :p].copy(),
+                                   self.heading[b, :p].copy(), self.active[b, :p].copy(),
+                                   int(self.node[b, p]), self.pos[b, p].copy()))
         agents = self.agents(b)
         for a in askers:  # a plan sets the target, the waypoints and the clock alone
             self._push_walk(b, a, agents[a])
