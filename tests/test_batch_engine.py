@@ -7,11 +7,15 @@ Small scale here; ``python -m headless.engines`` compares whole sweeps (docs/res
 from __future__ import annotations
 
 import concurrent.futures as cf
+import dataclasses
 from typing import Any
 
 import numpy as np
 import pytest
 
+from ai import register_player_policy, unregister_player_policy
+from ai.players import MaxMinPlayer
+from ai.view import Action, WorldView
 from game.batch import MAX_BATCH, Batch, run_trials, uncovered
 from game.config import Config
 from game.trial import TrialSpec, run_trial
@@ -80,6 +84,35 @@ def test_each_trial_keeps_its_own_clock_when_some_are_held() -> None:
     assert apart > 300  # the clocks ran far apart on the way
     held = [_result(r) for r in batch.run()]
     assert held == [_result(run_trial(s)) for s in specs]
+
+
+class _SprintingMaxMin(MaxMinPlayer):
+    """MaxMin that sprints at every other decision and walks at the rest: a policy with
+    actions of its own, which the batch engine hands the whole world to."""
+
+    policy = "sprinting-maxmin"
+
+    def decide(self, view: WorldView) -> int:
+        self.calls = getattr(self, "calls", 0) + 1
+        return super().decide(view)
+
+    def actions(self, view: WorldView) -> list[Action]:
+        return [Action("sprint" if self.calls % 2 else "walk")]
+
+
+def test_a_player_with_actions_of_its_own_plays_as_on_the_reference() -> None:
+    register_player_policy("sprinting-maxmin", _SprintingMaxMin)
+    try:
+        plain = [s for s in _paper("maze", "grid") if s.player == "maxmin"][:4]
+        specs = [dataclasses.replace(s, player="sprinting-maxmin") for s in plain]
+        batch = Batch(specs)
+        assert batch.acting.all()
+        rows = [_result(r) for r in batch.run()]
+        assert rows == [_result(run_trial(s)) for s in specs]
+        # the sprints changed the trials (the actions were played, not dropped)
+        assert [r[1] for r in rows] != [_result(run_trial(s))[1] for s in plain]
+    finally:
+        unregister_player_policy("sprinting-maxmin")
 
 
 def test_trials_of_different_levels_or_settings_are_not_one_batch() -> None:
