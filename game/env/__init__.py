@@ -7,6 +7,8 @@
 * :class:`StealthEnv` — a Gymnasium ``Env``: the agent is the player, the guards run one of
   the project's guard AIs (``pf``, ``fsm``, ...). Registered as ``"stealthfield/Stealth-v0"``
   when this module is imported.
+* :class:`StealthVectorEnv` (:mod:`game.env.vector`) — ``gymnasium.make_vec`` of that id: many
+  player episodes stepped together on the batch engine.
 
 Both drive the ordinary :class:`~game.world.World` through its public API: the player and
 externally controlled guards are controllers (:class:`ExternalPlayer`,
