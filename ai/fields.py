@@ -30,8 +30,8 @@ frame's spare time is :mod:`ai.prefetch`. The names of those modules are re-expo
 
 from __future__ import annotations
 
-import math
 from collections.abc import Sequence
+from types import ModuleType
 from typing import NamedTuple
 
 import numpy as np
@@ -67,6 +67,18 @@ def information_layer(values: np.ndarray | Sequence[float], n: int) -> np.ndarra
     if layer.shape != (n,):
         raise ValueError(f"extra_information must have shape ({n},), got {layer.shape}")
     return layer
+
+
+#: "no personal term" for the compiled scores
+_NO_TERM = np.zeros(0)
+
+
+def _field_kernels() -> ModuleType:
+    """The compiled decision scores (:mod:`ai.field_kernels`), imported at first use (numba
+    costs a second of start-up a program without PF guards need not pay)."""
+    from . import field_kernels
+
+    return field_kernels
 
 
 class Choice(NamedTuple):
@@ -383,39 +395,25 @@ class CompositeField:
         recent: Sequence[int] | np.ndarray,
         personal: np.ndarray | None,
     ) -> Choice | None:
-        """:meth:`select` on Python floats, for a graph with dense tables: each score is
-        the same IEEE operations in the same order as the array path (K, plus scale ×
-        the teammates' presence summed left to right, plus the revisit term, plus the
-        personal term), so the same bits and the same draw; None (use the array path)
-        when a score is NaN, where Python's ``min`` and numpy's disagree."""
-        cands = candidates.tolist()
-        scores = self.kernel()[candidates].tolist()
+        """:meth:`select` for a graph with dense tables, compiled (:mod:`ai.field_kernels`):
+        each score is the same IEEE operations in the same order as the array path (K, plus
+        scale × the teammates' presence summed left to right, plus the revisit term, plus
+        the personal term), so the same bits and the same draw; None (use the array path)
+        when a score is NaN, where a running minimum and numpy's disagree."""
         p = self.params
         scale = self.w_C * p.teammate_presence * p.C0
-        if len(teammates) and scale:
-            tm = np.asarray(teammates, dtype=np.intp)
-            table = self.matrices.presence_table
-            assert table is not None  # spreads.tables: the dense table exists
-            picked = table[candidates[:, None], tm].tolist()
-            for j, row in enumerate(picked):
-                total = row[0]
-                for value in row[1:]:
-                    total += value
-                scores[j] += scale * total
-        revisit = self.revisit_term(candidates, recent)
-        if revisit is not None:
-            for j, value in enumerate(revisit.tolist()):
-                scores[j] += value
-        if personal is not None:
-            for j, value in enumerate(personal[candidates].tolist()):
-                scores[j] += value
-        if any(map(math.isnan, scores)):
+        table = self.matrices.presence_table
+        assert table is not None  # spreads.tables: the dense table exists
+        revisit_scale = self.w_C * p.revisit_penalty * p.C0
+        revisit = bool(len(recent)) and bool(revisit_scale)  # revisit_term's condition
+        scores, tied, ok = _field_kernels().dense_scores(
+            self.kernel(), candidates, table, np.asarray(teammates, dtype=np.intp), scale,
+            np.asarray(recent, dtype=np.int64), revisit_scale * 1.0, revisit_scale * 0.0,
+            revisit, _NO_TERM if personal is None else personal, p.tie_eps)
+        if not ok:
             return None
-        low, eps = min(scores), p.tie_eps
-        tied = [c for c, x in zip(cands, scores, strict=True) if x - low < eps]
         winner = tied[0] if len(tied) == 1 else tied[rng.integers(len(tied))]
-        return Choice(int(winner), candidates, np.array(scores, dtype=np.float64),
-                      np.array(tied, dtype=candidates.dtype))
+        return Choice(int(winner), candidates, scores, tied)
 
     def choose(
         self,
