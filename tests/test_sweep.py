@@ -21,7 +21,7 @@ from headless import executors
 from headless.cli import main
 from headless.analysis.report import write_report
 from headless.store import ResultStore
-from headless.presets import load_preset
+from headless.presets import bundled_preset_names, load_preset
 from headless.progress import Progress
 from headless.sweep import run_sweep
 
@@ -424,3 +424,22 @@ def test_a_dying_worker_stops_the_sweep_and_keeps_finished_trials(
     with ResultStore(out / "results.sqlite", readonly=True) as store:
         finished, failed = store.count()
     assert 0 < finished < 24 and failed == 0
+
+
+@pytest.mark.parametrize("name", bundled_preset_names())
+def test_every_bundled_preset_loads_and_validates(name: str) -> None:
+    preset = load_preset(name)  # every [set] key and value checked, the levels read
+    assert preset.n_trials == len(preset.specs()) > 0
+
+
+def test_paper_inferred_is_the_paper_design_with_its_stated_rules() -> None:
+    paper, inferred = load_preset("paper"), load_preset("paper-inferred")
+    assert inferred.n_trials == 10_000
+    assert {k: v for k, v in inferred.design().items() if k != "set"} \
+        == {k: v for k, v in paper.design().items() if k != "set"}
+    stated = ("world.respawn", "pf.teammate_presence", "pf.revisit_penalty",
+              "world.attack_needs_line_of_sight", "metrics.backtracks",
+              "zones.dark_confidence_decay", "zones.concealment_confidence_decay",
+              "zones.concealment_view_scale")
+    ours, theirs = dict(inferred.overrides), dict(paper.overrides)
+    assert {k: ours[k] for k in stated} == {k: theirs[k] for k in stated}
