@@ -17,11 +17,11 @@ pytest.importorskip("pettingzoo")
 from gymnasium.utils.env_checker import check_env  # noqa: E402
 from pettingzoo.test import parallel_api_test, parallel_seed_test  # noqa: E402
 
-from game.env import ENV_ID, REWARDS, StealthEnv, parallel_env  # noqa: E402
+from game.env import ENV_ID, REWARDS, SHAPING, StealthEnv, parallel_env  # noqa: E402
 from game.trial import TrialSpec, make_world  # noqa: E402
 
 ABSTRACTIONS = ("grid", "partition")
-UNSHAPED = {"seen": 0.0, "proximity": 0.0}  # the game's own terms only
+UNSHAPED = dict.fromkeys(SHAPING, 0.0)  # the game's own terms only
 
 
 @pytest.mark.parametrize("abstraction", ABSTRACTIONS)
