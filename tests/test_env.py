@@ -17,11 +17,11 @@ pytest.importorskip("pettingzoo")
 from gymnasium.utils.env_checker import check_env  # noqa: E402
 from pettingzoo.test import parallel_api_test, parallel_seed_test  # noqa: E402
 
-from game.env import ENV_ID, REWARDS, StealthEnv, parallel_env  # noqa: E402
+from game.env import ENV_ID, REWARDS, SHAPING, StealthEnv, parallel_env  # noqa: E402
 from game.trial import TrialSpec, make_world  # noqa: E402
 
 ABSTRACTIONS = ("grid", "partition")
-UNSHAPED = {"seen": 0.0, "proximity": 0.0}  # the game's own terms only
+UNSHAPED = dict.fromkeys(SHAPING, 0.0)  # the game's own terms only
 
 
 @pytest.mark.parametrize("abstraction", ABSTRACTIONS)
@@ -55,9 +55,9 @@ def test_spaces_follow_the_abstraction() -> None:
     assert StealthEnv("maze", abstraction="partition").action_space.n == 9
     env = parallel_env("maze", world__guards=2, obs_radius=2, pad_observations=False)
     assert env.possible_agents == ["player_0", "guard_0", "guard_1"]
-    # player: 3 channels of 5x5, 7 own features, 7 per guard, 2 per action;
+    # player: 3 channels of 5x5, 7 own features, 7 per guard, 3 per action;
     # guards: 5 channels, 7, 5 per guard, 3
-    assert env.observation_space("player_0").shape == (3 * 25 + 7 + 2 * 7 + 5 * 2,)
+    assert env.observation_space("player_0").shape == (3 * 25 + 7 + 2 * 7 + 5 * 3,)
     assert env.observation_space("guard_1").shape == (5 * 25 + 7 + 2 * 5 + 3,)
     padded = parallel_env("maze", world__guards=2, obs_radius=2)  # the default: one size
     assert all(padded.observation_space(a) == env.observation_space("guard_1")
@@ -274,7 +274,32 @@ def test_player_observation_points_at_perceived_guards() -> None:
     moves = obs[base + len(PLAYER_GUARD) * m.n_guards:].reshape(-1, len(MOVE_FEATURES))
     near = m.graph.dist_from([w.guards[j].node for j in known]).min(axis=0)
     cap = 2 * m.view_range
-    assert np.allclose(moves[:, 1], np.minimum(near[m.moves[w.player.node]], cap) / cap, atol=1e-5)
+    reach = np.minimum(near[m.moves[w.player.node]], cap)
+    assert np.allclose(moves[:, 1], reach / cap, atol=1e-5)
+    # gain: how much farther than staying each move's target lies, in moves (cells), ±1 at most
+    assert moves[0, 2] == 0 and m.observer.edge == m.graph.mean_edge_length
+    assert np.allclose(moves[:, 2], np.clip((reach - reach[0]) / m.observer.edge, -1, 1), atol=1e-5)
+    assert set(np.round(moves[moves[:, 0] > 0, 2], 5)) <= {-1.0, 0.0, 1.0}  # grid: a cell a move
+
+
+def test_gain_tells_the_moves_apart_as_safety_does_in_move_units() -> None:
+    """``gain`` orders the actions as ``safety`` does (both measure the same distances), but a
+    move's worth of distance is 1, not 1 / (2 × view range in cells) ≈ 0.08: a policy's
+    first layer tells the safer move apart without weights of tens."""
+    from game.env import MOVE_FEATURES
+
+    env = StealthEnv("maze", guards="cheat", world__player_hp=1e6)
+    obs, _ = env.reset(seed=1)
+    k = len(MOVE_FEATURES) * env.action_space.n
+    differed, done = 0, False
+    while not done:
+        moves = obs[-k:].reshape(-1, len(MOVE_FEATURES))
+        safety, gain = moves[:, 1], moves[:, 2]
+        assert np.array_equal(np.sign(np.round(safety - safety[0], 6)), np.sign(gain))
+        differed += bool(np.ptp(safety) > 0)
+        obs, _, term, trunc, _ = env.step(int(np.argmax(gain)))
+        done = term or trunc
+    assert differed > 10
 
 
 def test_shaping_is_the_change_of_a_potential() -> None:

@@ -52,6 +52,7 @@ from .match import (  # re-exported: the env API names them
     GRID_ACTIONS,
     PARTITION_ACTIONS,
     REWARDS,
+    SHAPING,
     ExternalGuards,
     ExternalPlayer,
     Match,
@@ -346,7 +347,7 @@ if ENV_ID not in gymnasium.registry:
 __all__ = ["ENV_ID", "GRID_ACTIONS", "GUARD_CHANNELS", "GUARD_FEATURES", "MAX_EPISODE_STEPS",
            "MOVE_FEATURES", "OLD_PLAYER", "OTHER_GUARD", "PARTITION_ACTIONS", "PLAYER",
            "PLAYER_AS_SEEN", "PLAYER_CHANNELS", "PLAYER_FEATURES", "PLAYER_GUARD", "REWARDS",
-           "OBSERVATIONS", "STATE_FEATURES", "STATE_GUARD", "AgentDict", "FlatObsWrapper",
+           "SHAPING", "OBSERVATIONS", "STATE_FEATURES", "STATE_GUARD", "AgentDict", "FlatObsWrapper",
            "ImgObsWrapper", "ExternalGuards", "ExternalPlayer",
            "StealthEnv", "StealthParallelEnv", "StealthVectorEnv", "agent_name", "check_action",
            "env", "parallel_env", "raw_env"]

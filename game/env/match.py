@@ -28,7 +28,7 @@ from ..trial import TrialSpec, make_world
 from ..world import SCENARIOS, World
 
 __all__ = ["ExternalGuards", "ExternalPlayer", "GRID_ACTIONS", "Match", "Move",
-           "PARTITION_ACTIONS", "REWARDS"]
+           "PARTITION_ACTIONS", "REWARDS", "SHAPING"]
 
 #: Grid actions (Discrete(5)): stay and the four neighbouring cells (y grows downwards).
 GRID_ACTIONS = ("stay", "north", "east", "south", "west")
@@ -44,6 +44,9 @@ PARTITION_ACTIONS = ("stay", "north", "northeast", "east", "southeast",
 #: score, seconds survived, less 1 per HP and 3 per capture (what the fixed-time scenario,
 #: whose clock always runs out, scores); a step is worth about ±0.5 (issue 23).
 REWARDS = {"survival": 1.0, "hp": 1.0, "capture": 3.0, "seen": 1.0, "proximity": 3.0}
+#: The shaping terms of :data:`REWARDS` (the rest are the game's own score): with these at 0
+#: an episode's return is the game's.
+SHAPING = ("seen", "proximity")
 
 
 #: each graph's move table, built once (a read-only array shared by every env on the graph)

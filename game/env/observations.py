@@ -4,8 +4,9 @@ A window of ``(2r+1)²`` cells around the agent (channels :data:`PLAYER_CHANNELS
 :data:`GUARD_CHANNELS`) followed by the agent's own features and what it knows of the
 others; every entry lies in ``[-OBS_BOUND, OBS_BOUND]``. The player's guards are given
 relative to it in view-range units, nearest first, and each of its actions with how far its
-target lies from the guards it perceives (:data:`PLAYER_GUARD`, :data:`MOVE_FEATURES`): what
-a policy needs to step away from a guard without learning the level's geometry first.
+target lies from the guards it perceives and how much farther than where it stands
+(:data:`PLAYER_GUARD`, :data:`MOVE_FEATURES`): what a policy needs to step away from a guard
+without learning the level's geometry first.
 """
 
 from __future__ import annotations
@@ -39,9 +40,13 @@ GUARD_FEATURES = ("x", "y", "cos_heading", "sin_heading", "player_hp", "time", "
 OTHER_GUARD = ("known", "dx", "dy", "cos_heading", "sin_heading")
 #: The player's slot per guard, nearest perceived guard first (offsets ÷ view range).
 PLAYER_GUARD = ("known", "dx", "dy", "distance", "cos_heading", "sin_heading", "facing")
-#: The player's features per action: it moves (not stay / into a wall), and the path
-#: distance from its target to the nearest perceived guard ÷ (2 × view range), at most 1.
-MOVE_FEATURES = ("open", "safety")
+#: The player's features per action: it moves (not stay / into a wall); the path
+#: distance from its target to the nearest perceived guard ÷ (2 × view range), at most 1;
+#: and how much farther from that guard its target lies than the player's own node does,
+#: in moves (÷ the graph's mean edge length), within ±1 (0 with no guard perceived).
+#: ``gain`` repeats what ``safety`` says in units a policy reads without large weights:
+#: one move is ±1 there, ±0.08 in ``safety`` (issue 41, docs/api.md).
+MOVE_FEATURES = ("open", "safety", "gain")
 PLAYER_AS_SEEN = ("known", "dx", "dy")
 #: The global state (``parallel_env``'s ``state()``, for a centralised critic): the true
 #: positions of everyone, whatever anyone perceives; positions ÷ the level's width / height.
@@ -87,6 +92,8 @@ class Observer:
         self.cell_node = np.pad(cell_node, r, constant_values=-1)
         self.walkable = level.walkable
         shapely.prepare(self.walkable)
+        #: the length one move covers, what ``gain`` counts in
+        self.edge = float(graph.mean_edge_length) or cs
 
     def _cell(self, pos: Any) -> tuple[int, int]:
         return (min(max(int(pos[1] // self.cell_size), 0), self.level.rows - 1),
@@ -180,12 +187,14 @@ class Observer:
         targets = self.moves[node]
         cap = 2.0 * scale
         if known:
-            near = self.graph.nearest_dist(view.guard_nodes[known], limit=cap)[targets]
-            safety = (np.minimum(near, cap) / cap).tolist()
+            near = np.minimum(self.graph.nearest_dist(view.guard_nodes[known], limit=cap)[targets], cap)
+            safety = (near / cap).tolist()
+            gain = np.clip((near - near[0]) / self.edge, -1.0, 1.0).tolist()
         else:
             safety = [1.0] * len(targets)
+            gain = [0.0] * len(targets)
         for a, target in enumerate(targets.tolist()):
-            vec += [float(a == 0 or target != node), safety[a]]
+            vec += [float(a == 0 or target != node), safety[a], gain[a]]
         return self._pack(win, vec)
 
     def observe_guard(self, world: World, view: WorldView, i: int,

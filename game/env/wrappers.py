@@ -13,7 +13,7 @@ alone. As in MiniGrid, wrappers turn the dict into the other two:
 >>> env = StealthEnv("maze", observation="dict")
 >>> obs, _ = env.reset(seed=0)
 >>> obs["image"].shape, obs["features"].shape
-((5, 5, 3), (38,))
+((5, 5, 3), (43,))
 >>> flat, _ = FlatObsWrapper(env).reset(seed=0)
 >>> bool((flat == StealthEnv("maze").reset(seed=0)[0]).all())
 True
