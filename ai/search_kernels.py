@@ -9,6 +9,8 @@ import heapq
 import numpy as np
 from numba import njit
 
+from navmesh.path_kernels import tree_path
+
 
 @njit(cache=True)
 def astar(start: int, goal: int, indptr: np.ndarray, indices: np.ndarray,
@@ -26,18 +28,7 @@ def astar(start: int, goal: int, indptr: np.ndarray, indices: np.ndarray,
     while len(open_list) > 0:
         _, _, u = heapq.heappop(open_list)
         if u == goal:
-            length = 1
-            v = u
-            while v != start:
-                v = parent[v]
-                length += 1
-            path = np.empty(length, dtype=np.int64)
-            v = u
-            for k in range(length - 1, -1, -1):
-                path[k] = v
-                if k > 0:
-                    v = parent[v]
-            return path
+            return tree_path(parent, start, goal)
         if closed[u]:
             continue
         closed[u] = True

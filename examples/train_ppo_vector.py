@@ -25,6 +25,7 @@ import numpy as np
 from stable_baselines3.common.vec_env import VecEnv
 
 from game.env import StealthEnv, StealthVectorEnv
+from train_ppo import play  # examples/train_ppo.py: the same held-out play
 
 
 class SB3VecEnv(VecEnv):
@@ -75,23 +76,6 @@ class SB3VecEnv(VecEnv):
 
     def env_is_wrapped(self, wrapper_class: type, indices: Any = None) -> list[bool]:
         return [False for _ in self._get_indices(indices)]
-
-
-def play(env: StealthEnv, policy: Any, seeds: range) -> dict[str, np.ndarray]:
-    """Survival time, captured flag and unshaped return of ``policy`` on each seed."""
-    out: dict[str, list[float]] = {"survival": [], "captured": [], "return": []}
-    for seed in seeds:
-        rng = np.random.default_rng(seed)
-        obs, info = env.reset(seed=seed)
-        total, done = 0.0, False
-        while not done:
-            obs, reward, terminated, truncated, info = env.step(policy(obs, rng))
-            total += reward
-            done = terminated or truncated
-        out["survival"].append(info["t"])
-        out["captured"].append(float(info["captures"] > 0))
-        out["return"].append(total)
-    return {k: np.asarray(v) for k, v in out.items()}
 
 
 def main() -> None:
